@@ -1,0 +1,139 @@
+#include "strata/core/error.h"
+#include "strata/io/atomic_file.h"
+#include "strata/io/json_io.h"
+#include "support/fixtures.h"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+using namespace strata;
+using Catch::Matchers::Contains;
+
+namespace {
+
+void require_same(const Scene& a, const Scene& b) {
+    REQUIRE(a.size() == b.size());
+    CHECK(a.units() == b.units());
+    CHECK(a.metadata == b.metadata);
+    CHECK(a.is_implicit_stack() == b.is_implicit_stack());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const Layer& la = a.layer(i);
+        const Layer& lb = b.layer(i);
+        CHECK(la.name == lb.name);
+        CHECK(la.closed == lb.closed);
+        CHECK(la.thickness == lb.thickness);
+        CHECK(la.weight == lb.weight);
+        CHECK(la.alpha == lb.alpha);
+        CHECK(la.beta == lb.beta);
+        CHECK(la.outer == lb.outer);
+        CHECK(la.extra == lb.extra);
+        CHECK(la.points == lb.points);  // bit-exact
+    }
+}
+
+const char* kExample = R"({
+  "strata": 1, "units": "m", "producer": {"tool": "x", "version": 3},
+  "layers": [
+    {"name": "body", "closed": true, "thickness": 0.01, "weight": 4, "outer": ["shirt"],
+     "points": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+    {"name": "shirt", "closed": true, "thickness": 0.02, "alpha": 0.5, "beta": 0.25,
+     "colour": "red", "outer": [],
+     "points": [[-0.5, -0.5], [1.5, -0.5], [1.5, 1.5], [-0.5, 1.5]]}
+  ]
+})";
+
+}  // namespace
+
+TEST_CASE("the documented example parses with every field", "[io][json]") {
+    const Scene scene = parse_scene_json(kExample, "example.json");
+    REQUIRE(scene.size() == 2);
+    CHECK(scene.units() == "m");
+    CHECK(scene.layer(0).weight == 4.0);
+    CHECK(scene.layer(1).alpha == 0.5);
+    CHECK(scene.layer(1).beta == 0.25);
+    CHECK(scene.relation(0, 1) == Relation::Under);
+    CHECK(scene.required_separation(0, 1) == Approx(0.015));
+    // Unknown keys are kept and noted, never dropped.
+    CHECK(scene.metadata.at("producer") == R"({"tool":"x","version":3})");
+    CHECK(scene.layer(1).extra.at("colour") == "\"red\"");
+    REQUIRE_FALSE(scene.diagnostics().notes.empty());
+    CHECK_THAT(scene.diagnostics().notes.back(), Contains("\"producer\"") && Contains("\"colour\""));
+}
+
+TEST_CASE("JSON round trips are exact", "[io][json]") {
+    SECTION("generated scenes") {
+        for (const Scene& scene : {test::nested_circles(3, 37, 1.0 / 3.0, 0.1, 0.01),
+                                   test::stacked_sines(5, 101), test::spiral(3.5, 200)}) {
+            require_same(scene, parse_scene_json(scene_to_json(scene)));
+        }
+    }
+    SECTION("a file with metadata, params and explicit nesting") {
+        const Scene scene = parse_scene_json(kExample);
+        require_same(scene, parse_scene_json(scene_to_json(scene)));
+    }
+    SECTION("every real slice") {
+        for (const char* name :
+             {"cipc_multilayer_y+0.00.json", "cipc_multilayer_y-0.15.json", "cipc_multilayer_y-0.30.json",
+              "mh_casualsuit03_y+1.50.json", "mh_casualsuit03_y+4.00.json", "mh_casualsuit05_y+4.00.json",
+              "mh_elegantsuit01_y+0.50.json", "mh_elegantsuit01_y+1.50.json"}) {
+            INFO(name);
+            const Scene scene = read_scene_json(test::test_data(std::string("slices/") + name));
+            CHECK_FALSE(scene.is_implicit_stack());
+            CHECK(scene.metadata.count("source") == 1);
+            require_same(scene, parse_scene_json(scene_to_json(scene)));
+        }
+    }
+}
+
+TEST_CASE("bad JSON names the file, line and column", "[io][json]") {
+    CHECK_THROWS_WITH(parse_scene_json("{\n  \"layers\": [\n    {\"points\": [[0, 0], [1 1]]}\n  ]\n}", "bad.json"),
+                      Contains("bad.json:3:") && Contains("invalid JSON"));
+    CHECK_THROWS_WITH(parse_scene_json("{\"layers\": [", "cut.json"), Contains("cut.json:1:13"));
+}
+
+TEST_CASE("bad content names the layer, the key and the value", "[io][json]") {
+    auto fails = [](const std::string& text) {
+        try {
+            parse_scene_json(text, "f.json");
+        } catch (const InvalidInput& e) {
+            return std::string(e.what());
+        }
+        FAIL("no exception for " << text);
+        return std::string();
+    };
+    CHECK_THAT(fails(R"({"layers": [{"name": "a", "points": [[0, 0], [1, "x"]]}]})"),
+               Contains("f.json") && Contains("('a').points[1]") && Contains("[1,\"x\"]"));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a", "thickness": "thick", "points": [[0, 0], [1, 0]]}]})"),
+               Contains("('a').thickness") && Contains("\"thick\""));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a", "thickness": -2, "points": [[0, 0], [1, 0]]}]})"),
+               Contains("f.json") && Contains("layer 'a'") && Contains("thickness") && Contains("got -2"));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a", "closed": 1, "points": [[0, 0], [1, 0]]}]})"),
+               Contains("('a').closed") && Contains("true or false"));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a"}]})"), Contains("('a')") && Contains("missing \"points\""));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a", "outer": ["b"], "points": [[0, 0], [1, 0]]}]})"),
+               Contains("'b'") && Contains("not a layer"));
+    CHECK_THAT(fails(R"({"strata": 2, "layers": []})"), Contains("unsupported format version 2"));
+    CHECK_THAT(fails(R"({"layer": []})"), Contains("missing \"layers\""));
+    CHECK_THAT(fails(R"([1, 2])"), Contains("expected an object"));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a", "points": [[0, 0], [1e999, 0]]}]})"),
+               Contains("f.json") && Contains("overflow") && Contains("1e999"));
+}
+
+TEST_CASE("writing is atomic and never overwrites an input", "[io][json]") {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "strata_test_json_io";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path file = dir / "scene.json";
+    const Scene scene = test::nested_circles(2, 8);
+    write_scene_json(scene, file);
+    require_same(scene, read_scene_json(file));
+    CHECK_THROWS_AS(ensure_not_an_input(file, {dir / "other.json", file}), InvalidInput);
+    CHECK_NOTHROW(ensure_not_an_input(dir / "new.json", {file}));
+    // A write into a missing folder fails cleanly and leaves nothing behind.
+    CHECK_THROWS_WITH(write_scene_json(scene, dir / "missing" / "x.json"), Contains("does not exist"));
+    CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+    CHECK_THROWS_WITH(read_scene_json(dir / "absent.json"), Contains("absent.json") && Contains("cannot open"));
+    fs::remove_all(dir);
+}
