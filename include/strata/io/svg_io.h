@@ -1,0 +1,70 @@
+#pragma once
+/// @file SVG in and out, so that a person can draw a scene or look at one in a browser.
+///
+/// Reading: <polyline>, <polygon> and <path> elements in document order, inside to outside;
+/// `transform` attributes (of the element and its ancestors) applied; y is flipped (SVG's y
+/// points down, strata's up). Attributes data-thickness, data-weight, data-alpha, data-beta,
+/// data-outer (space- or comma-separated names) and id (the layer name) are honoured.
+/// Writing: one coloured <polyline>/<polygon> per layer carrying the same data-* attributes,
+/// viewBox fitted to the scene, y flipped back, so that read(write(scene)) == scene.
+///
+/// Details of reading:
+/// - <path> data follows the full SVG grammar (M L H V Z C S Q T A, absolute and relative,
+///   implicit repeats); curves and arcs are flattened within `flatten_tolerance`. Each subpath
+///   is one layer (closed when it ends with Z), named id, id_2, id_3 ...; a subpath made of a
+///   lone moveto is ignored. <polygon> is closed, <polyline> open; <line>, <rect>, <circle>
+///   and <ellipse> are read too. A layer without an id is called "layer_<k>", k its index.
+/// - `transform` functions: matrix, translate, scale, rotate (with optional centre), skewX,
+///   skewY, in lists. The root's viewBox is ignored: points are in the root's user units.
+/// - Skipped: the content of <defs>, <clipPath>, <mask>, <symbol>, <marker>, <pattern>, and
+///   any element whose data-strata-role is not "layer" (the writer marks its underlay and
+///   vertex dots "underlay" and "vertices").
+/// - When any element has data-outer, every layer has `outer` set (empty when absent);
+///   otherwise the document order is one implicit stack. data-strata-units on the root <svg>
+///   gives the scene's units. Layer::extra and Scene::metadata are not carried by SVG.
+
+#include "strata/geometry/scene.h"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace strata {
+
+/// Parameters of parse_scene_svg().
+struct SvgReadParams {
+    /// Largest distance between a curve (C/S/Q/T/A path commands) and its flattened
+    /// polyline, in SVG user units (after transforms). > 0.
+    double flatten_tolerance = 0.01;
+};
+
+/// Throws InvalidInput naming the first out-of-range field.
+void validate(const SvgReadParams& params);
+
+/// Parses a scene from SVG text. @throws InvalidInput naming `source`, the element (by its
+/// line and id) and the attribute and value at fault.
+Scene parse_scene_svg(std::string_view text, const std::string& source = "<svg>",
+                      const SvgReadParams& params = {});
+/// parse_scene_svg() of a file's content. @throws IoError unreadable file.
+Scene read_scene_svg(const std::filesystem::path& path, const SvgReadParams& params = {});
+
+/// Parameters of scene_to_svg().
+struct SvgWriteParams {
+    const Scene* underlay = nullptr;  ///< Optional: drawn faintly under the scene (e.g. the original).
+    double width_px = 800.0;          ///< Width of the picture in pixels; height keeps the aspect.
+    double stroke_px = 1.5;           ///< Stroke width of the layers in pixels.
+    bool draw_vertices = false;       ///< Small dots at the vertices.
+};
+
+/// Throws InvalidInput naming the first out-of-range field (width_px > 0, stroke_px >= 0).
+void validate(const SvgWriteParams& params);
+
+/// A standalone SVG document showing `scene` (and the underlay). Coordinates are written
+/// with round-trip precision; the underlay is a <g data-strata-role="underlay"> that
+/// parse_scene_svg() skips. @throws InvalidInput bad params.
+std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params = {});
+/// scene_to_svg() written atomically to `path`. @throws IoError.
+void write_scene_svg(const Scene& scene, const std::filesystem::path& path,
+                     const SvgWriteParams& params = {});
+
+}  // namespace strata
