@@ -73,7 +73,8 @@ Scene::Scene(std::vector<Layer> layers, std::string units)
     std::unordered_map<std::string, std::size_t> index;
     for (std::size_t i = 0; i < n; ++i) {
         Layer& layer = layers_[i];
-        if (layer.name.empty()) throw InvalidInput("layer #" + std::to_string(i) + ": name must not be empty");
+        if (layer.name.empty())
+            throw InvalidInput("layer #" + std::to_string(i) + ": name must not be empty");
         if (!index.emplace(layer.name, i).second)
             throw InvalidInput(layer_label(layer, i) + ": name already used by layer #" +
                                std::to_string(index[layer.name]));
@@ -134,7 +135,10 @@ Scene::Scene(std::vector<Layer> layers, std::string units)
         for (;;) {
             std::size_t next = n;
             for (std::size_t j : outer_[path.back()])
-                if (indegree[j] != 0) { next = j; break; }
+                if (indegree[j] != 0) {
+                    next = j;
+                    break;
+                }
             path.push_back(next);
             if (seen[next]) break;
             seen[next] = 1;

@@ -55,9 +55,9 @@ TEST_CASE("outer links give a DAG with side-by-side layers", "[scene]") {
     REQUIRE_FALSE(scene.is_implicit_stack());
     CHECK(scene.relation(0, 1) == Relation::SideBySide);
     CHECK(scene.relation(1, 3) == Relation::Under);
-    CHECK(scene.required_separation(0, 1) == Approx(0.3));        // (0.2 + 0.4) / 2
-    CHECK(scene.required_separation(1, 2) == Approx(0.25));       // (0.4 + 0.1) / 2
-    CHECK(scene.required_separation(1, 3) == Approx(0.25 + 0.2)); // + (0.1 + 0.3) / 2
+    CHECK(scene.required_separation(0, 1) == Approx(0.3));         // (0.2 + 0.4) / 2
+    CHECK(scene.required_separation(1, 2) == Approx(0.25));        // (0.4 + 0.1) / 2
+    CHECK(scene.required_separation(1, 3) == Approx(0.25 + 0.2));  // + (0.1 + 0.3) / 2
 }
 
 TEST_CASE("separation along several chains takes the longest one", "[scene]") {

@@ -9,7 +9,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 }
 
-Scene nested_circles(std::size_t count, std::size_t points, double r0, double dr, double thickness) {
+Scene nested_circles(std::size_t count, std::size_t points, double r0, double dr,
+                     double thickness) {
     std::vector<Layer> layers;
     for (std::size_t k = 0; k < count; ++k) {
         Layer layer;
@@ -35,7 +36,8 @@ Scene stacked_sines(std::size_t count, std::size_t points, double amplitude, dou
         layer.thickness = thickness;
         for (std::size_t i = 0; i < points; ++i) {
             const double x = 4.0 * kPi * static_cast<double>(i) / static_cast<double>(points - 1);
-            layer.points.emplace_back(x, spacing * static_cast<double>(k) + amplitude * std::sin(x));
+            layer.points.emplace_back(x,
+                                      spacing * static_cast<double>(k) + amplitude * std::sin(x));
         }
         layers.push_back(std::move(layer));
     }
@@ -69,7 +71,8 @@ Scene spiral(double turns, std::size_t points) {
     Layer layer;
     layer.name = "spiral";
     for (std::size_t i = 0; i < points; ++i) {
-        const double t = 2.0 * kPi * turns * static_cast<double>(i) / static_cast<double>(points - 1);
+        const double t =
+            2.0 * kPi * turns * static_cast<double>(i) / static_cast<double>(points - 1);
         const double r = 0.1 + 0.1 * t / (2.0 * kPi);
         layer.points.emplace_back(r * std::cos(t), r * std::sin(t));
     }

@@ -29,7 +29,9 @@ struct Box2 {
         }
     }
     /// Grows the box by `d` (scene units) on every side.
-    Box2 inflated(double d) const { return is_empty() ? *this : Box2{min - Vec2(d), max + Vec2(d)}; }
+    Box2 inflated(double d) const {
+        return is_empty() ? *this : Box2{min - Vec2(d), max + Vec2(d)};
+    }
     bool overlaps(const Box2& b) const {
         return !is_empty() && !b.is_empty() && min.x <= b.max.x && b.min.x <= max.x &&
                min.y <= b.max.y && b.min.y <= max.y;

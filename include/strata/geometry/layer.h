@@ -14,13 +14,13 @@ namespace strata {
 /// A layer: a planar polyline (open, or closed with an implicit closing segment) and the
 /// physical parameters the untangling uses. Lengths are in scene units.
 struct Layer {
-    std::string name;              ///< Unique within a scene, non-empty.
-    std::vector<Vec2> points;      ///< Vertices in order; >= 2 (open) or >= 3 (closed).
-    bool closed = false;           ///< True: a segment joins the last point to the first.
-    double thickness = 0.0;        ///< Cloth thickness, scene units, >= 0.
-    double weight = 1.0;           ///< > 0; a larger weight is stiffer and moves less.
-    std::optional<double> alpha;   ///< Shape-matching stiffness in [0, 1]; unset: the default.
-    std::optional<double> beta;    ///< Shape-matching quadratic share in [0, 1]; unset: the default.
+    std::string name;             ///< Unique within a scene, non-empty.
+    std::vector<Vec2> points;     ///< Vertices in order; >= 2 (open) or >= 3 (closed).
+    bool closed = false;          ///< True: a segment joins the last point to the first.
+    double thickness = 0.0;       ///< Cloth thickness, scene units, >= 0.
+    double weight = 1.0;          ///< > 0; a larger weight is stiffer and moves less.
+    std::optional<double> alpha;  ///< Shape-matching stiffness in [0, 1]; unset: the default.
+    std::optional<double> beta;   ///< Shape-matching quadratic share in [0, 1]; unset: the default.
     /// Names of the layers directly outside this one. Unset (as opposed to empty) in every
     /// layer of a scene means the file order is one stack, innermost first.
     std::optional<std::vector<std::string>> outer;

@@ -1,0 +1,650 @@
+#include "strata/geometry/checks.h"
+
+#include "strata/core/error.h"
+#include "strata/core/format.h"
+#include "strata/geometry/predicates.h"
+
+// Boost 1.74's Geometry includes one of its own deprecated headers, which prints a note.
+#ifndef BOOST_ALLOW_DEPRECATED_HEADERS
+#define BOOST_ALLOW_DEPRECATED_HEADERS
+#endif
+#include <boost/geometry/geometries/box.hpp>
+#include <boost/geometry/geometries/point.hpp>
+#include <boost/geometry/geometries/segment.hpp>
+#include <boost/geometry/index/rtree.hpp>
+#include <boost/geometry/strategies/strategies.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace strata {
+
+namespace {
+
+namespace bg = boost::geometry;
+namespace bgi = boost::geometry::index;
+
+using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
+using BBox = bg::model::box<BPoint>;
+using BSegment = bg::model::segment<BPoint>;
+// Broad phases on boxes (exact comparisons); nearest queries on the segments themselves.
+using Entry = std::pair<BBox, std::size_t>;  // a segment's box and its index
+using Tree = bgi::rtree<Entry, bgi::quadratic<16>>;
+using SegmentEntry = std::pair<BSegment, std::size_t>;
+using SegmentTree = bgi::rtree<SegmentEntry, bgi::quadratic<16>>;
+
+constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+BBox segment_box(const Vec2& a, const Vec2& b) {
+    return BBox(BPoint(std::min(a.x, b.x), std::min(a.y, b.y)),
+                BPoint(std::max(a.x, b.x), std::max(a.y, b.y)));
+}
+
+BSegment segment_of(const Vec2& a, const Vec2& b) {
+    return BSegment(BPoint(a.x, a.y), BPoint(b.x, b.y));
+}
+
+bool lex_less(const Vec2& a, const Vec2& b) {
+    return a.x < b.x || (a.x == b.x && a.y < b.y);
+}
+
+// The segments of one layer that take part in the checks, in an rtree. Zero-length segments
+// (left by Scene::set_points, which keeps duplicates) are skipped: their point is an end of
+// their neighbours. A layer all of whose segments have zero length keeps its first one.
+class SegmentIndex {
+  public:
+    SegmentIndex() = default;
+
+    explicit SegmentIndex(const Layer& layer) : layer_(&layer) {
+        const std::size_t count = layer.segment_count();
+        position_.assign(count, kNone);
+        for (std::size_t s = 0; s < count; ++s)
+            if (layer.segment_start(s) != layer.segment_end(s)) add(s);
+        if (segments_.empty() && count > 0) add(0);
+        std::vector<Entry> boxes;
+        std::vector<SegmentEntry> pieces;
+        boxes.reserve(segments_.size());
+        pieces.reserve(segments_.size());
+        for (std::size_t s : segments_) {
+            boxes.emplace_back(segment_box(start(s), end(s)), s);
+            pieces.emplace_back(segment_of(start(s), end(s)), s);
+        }
+        tree_ = Tree(boxes.begin(), boxes.end());  // packing construction
+        segment_tree_ = SegmentTree(pieces.begin(), pieces.end());
+    }
+
+    const Layer& layer() const { return *layer_; }
+    const Tree& tree() const { return tree_; }
+    const SegmentTree& segment_tree() const { return segment_tree_; }
+    /// Indices of the kept segments, increasing.
+    const std::vector<std::size_t>& segments() const { return segments_; }
+    Vec2 start(std::size_t s) const { return layer_->segment_start(s); }
+    Vec2 end(std::size_t s) const { return layer_->segment_end(s); }
+
+    /// The kept segment after / before kept segment `s` (cyclic when closed), or kNone.
+    std::size_t next(std::size_t s) const {
+        const std::size_t k = position_[s];
+        if (k + 1 < segments_.size()) return segments_[k + 1];
+        return layer_->closed && segments_.size() > 1 ? segments_.front() : kNone;
+    }
+    std::size_t previous(std::size_t s) const {
+        const std::size_t k = position_[s];
+        if (k > 0) return segments_[k - 1];
+        return layer_->closed && segments_.size() > 1 ? segments_.back() : kNone;
+    }
+    bool is_first(std::size_t s) const { return segments_.front() == s; }
+    bool is_last(std::size_t s) const { return segments_.back() == s; }
+
+  private:
+    void add(std::size_t s) {
+        position_[s] = segments_.size();
+        segments_.push_back(s);
+    }
+
+    const Layer* layer_ = nullptr;
+    std::vector<std::size_t> segments_;
+    std::vector<std::size_t> position_;
+    Tree tree_;
+    SegmentTree segment_tree_;
+};
+
+struct Nearest {
+    double distance = kInf;
+    std::size_t segment = kNone;
+    Vec2 point{0.0};
+    bool found() const { return segment != kNone; }
+};
+
+// Closest point of the indexed layer to `p` if closer than `cutoff`: one best-first nearest
+// query of the rtree, whose leaves are the segments themselves.
+Nearest nearest_on(const SegmentIndex& index, const Vec2& p, double cutoff = kInf) {
+    Nearest best;
+    SegmentEntry found;
+    if (index.segment_tree().query(bgi::nearest(BPoint(p.x, p.y), 1), &found) == 0) return best;
+    Vec2 closest;
+    const double d =
+        point_segment_distance(p, index.start(found.second), index.end(found.second), &closest);
+    if (d < cutoff) {
+        best.distance = d;
+        best.segment = found.second;
+        best.point = closest;
+    }
+    return best;
+}
+
+double automatic_near(const Scene& scene) {
+    double max_required = 0.0;
+    for (std::size_t a = 0; a < scene.size(); ++a)
+        for (std::size_t b = a + 1; b < scene.size(); ++b)
+            max_required = std::max(max_required, scene.required_separation(a, b));
+    const Vec2 size = scene.bounds().size();
+    return std::max(0.05 * std::hypot(size.x, size.y), 2.0 * max_required);
+}
+
+// Side of `v` with respect to the open or closed layer of `index`, at its closest point:
+// +1 right of the direction of travel, -1 left, 0 when not decided (farther than `near`, on
+// the layer, or closest to an end point of an open layer).
+int side_at(const SegmentIndex& index, const Vec2& v, double near) {
+    const Nearest n = nearest_on(index, v, near);
+    if (!n.found() || n.distance == 0.0) return 0;
+    const std::size_t s = n.segment;
+    const Vec2 a = index.start(s), b = index.end(s);
+    const bool open = !index.layer().closed;
+    std::size_t before = kNone, after = kNone;  // segments meeting at the closest vertex
+    if (n.point == a) {
+        if (open && index.is_first(s)) return 0;
+        before = index.previous(s);
+        after = s;
+    } else if (n.point == b) {
+        if (open && index.is_last(s)) return 0;
+        before = s;
+        after = index.next(s);
+    }
+    if (before == kNone || after == kNone) {
+        const int o = orient2d(a, b, v);
+        return -o;
+    }
+    const Vec2 u = index.start(before), w = index.end(before), x = index.end(after);
+    const int turn = orient2d(u, w, x);
+    const int o1 = orient2d(u, w, v);
+    const int o2 = orient2d(w, x, v);
+    if (turn > 0) return (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
+    if (turn < 0) return (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
+    return o1 != 0 ? -o1 : -o2;
+}
+
+int closed_outside(const Layer& layer) {
+    // Shoelace sum; positive: counter-clockwise, interior on the left, outside on the right.
+    long double area = 0.0L;
+    const std::size_t n = layer.points.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        const Vec2& p = layer.points[k];
+        const Vec2& q = layer.points[(k + 1) % n];
+        area += static_cast<long double>(p.x) * q.y - static_cast<long double>(q.x) * p.y;
+    }
+    return area < 0.0L ? -1 : 1;
+}
+
+int open_outside(const Scene& scene, std::size_t i, const SegmentIndex& index, double near) {
+    long vote = 0;
+    for (std::size_t j : scene.inner_of(i))
+        for (const Vec2& v : scene.layer(j).points) vote -= side_at(index, v, near);
+    if (vote != 0) return vote > 0 ? 1 : -1;
+    for (std::size_t j : scene.outer_of(i))
+        for (const Vec2& v : scene.layer(j).points) vote += side_at(index, v, near);
+    if (vote != 0) return vote > 0 ? 1 : -1;
+    return 1;
+}
+
+enum class Placement { Inside, Outside, OnBoundary };
+
+// Exact placement of `v` with respect to the closed layer of `index` (non-zero winding rule).
+Placement placement(const SegmentIndex& index, const Box2& bounds, const Vec2& v) {
+    if (!bounds.contains(v)) return Placement::Outside;
+    std::vector<Entry> hits;
+    index.tree().query(bgi::intersects(BBox(BPoint(v.x, v.y), BPoint(bounds.max.x, v.y))),
+                       std::back_inserter(hits));
+    long winding = 0;
+    for (const Entry& e : hits) {
+        const Vec2 p = index.start(e.second), q = index.end(e.second);
+        const int o = orient2d(p, q, v);
+        if (o == 0 && std::min(p.x, q.x) <= v.x && v.x <= std::max(p.x, q.x) &&
+            std::min(p.y, q.y) <= v.y && v.y <= std::max(p.y, q.y))
+            return Placement::OnBoundary;
+        if (p.y <= v.y) {
+            if (q.y > v.y && o > 0) ++winding;
+        } else if (q.y <= v.y && o < 0) {
+            --winding;
+        }
+    }
+    return winding != 0 ? Placement::Inside : Placement::Outside;
+}
+
+// A contact found by the sweep over segment pairs.
+struct Contact {
+    std::size_t la, sa, lb, sb;
+    Vec2 point;
+    bool is_touch;
+};
+
+bool contact_order(const Contact& x, const Contact& y) {
+    return std::tie(x.la, x.sa, x.lb, x.sb) < std::tie(y.la, y.sa, y.lb, y.sb);
+}
+
+// Representative point of a Touch: the lexicographically smallest point of the intersection,
+// which is always an end of one segment lying on the other.
+Vec2 touch_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
+    auto on = [](const Vec2& x, const Vec2& a, const Vec2& b) {
+        return orient2d(a, b, x) == 0 && std::min(a.x, b.x) <= x.x && x.x <= std::max(a.x, b.x) &&
+               std::min(a.y, b.y) <= x.y && x.y <= std::max(a.y, b.y);
+    };
+    bool any = false;
+    Vec2 best{0.0};
+    auto consider = [&](const Vec2& x, const Vec2& a, const Vec2& b) {
+        if (on(x, a, b) && (!any || lex_less(x, best))) {
+            best = x;
+            any = true;
+        }
+    };
+    consider(p0, q0, q1);
+    consider(p1, q0, q1);
+    consider(q0, p0, p1);
+    consider(q1, p0, p1);
+    return best;
+}
+
+// Adjacent segments [u, v] and [v, w] that fold back onto each other: collinear, opposite
+// directions. Sets `point` to the representative point of their overlap.
+bool folds_back(const Vec2& u, const Vec2& v, const Vec2& w, Vec2& point) {
+    if (orient2d(u, v, w) != 0) return false;
+    const bool use_x = u.x != v.x;
+    const double cu = use_x ? u.x : u.y, cv = use_x ? v.x : v.y, cw = use_x ? w.x : w.y;
+    if ((cv > cu) == (cw > cv)) return false;
+    // u and w lie on the same side of v; the nearer one ends the overlap.
+    const bool u_nearer = cu > cv ? cu <= cw : cu >= cw;
+    const Vec2 other = u_nearer ? u : w;
+    point = lex_less(other, v) ? other : v;
+    return true;
+}
+
+// Merges the listed proper contacts with the deduplicated touches, keeps the first `cap`.
+std::vector<Contact> merged_list(std::vector<Contact> proper, const std::vector<Contact>& touches,
+                                 std::size_t cap) {
+    proper.insert(proper.end(), touches.begin(), touches.end());
+    std::sort(proper.begin(), proper.end(), contact_order);
+    if (proper.size() > cap) proper.resize(cap);
+    return proper;
+}
+
+Crossing to_crossing(const Contact& c) {
+    Crossing x;
+    x.layer_a = c.la;
+    x.segment_a = c.sa;
+    x.layer_b = c.lb;
+    x.segment_b = c.sb;
+    x.point = c.point;
+    x.is_touch = c.is_touch;
+    return x;
+}
+
+class Checker {
+  public:
+    Checker(const Scene& scene, const CheckParams& params) : scene_(scene), params_(params) {
+        n_ = scene.size();
+        indices_.reserve(n_);
+        bounds_.reserve(n_);
+        for (std::size_t i = 0; i < n_; ++i) {
+            indices_.emplace_back(scene.layer(i));
+            bounds_.push_back(scene.layer(i).bounds());
+        }
+        met_.assign(n_ * n_, 0);
+        met_point_.assign(n_ * n_, Vec2(0.0));
+        report_.near_distance =
+            params.near_distance > 0.0 ? params.near_distance : automatic_near(scene);
+        report_.self_crossing_count.assign(n_, 0);
+    }
+
+    CheckReport run() {
+        find_contacts();
+        find_separations();
+        find_nesting_violations();
+        return std::move(report_);
+    }
+
+  private:
+    void note_meeting(std::size_t a, std::size_t b, const Vec2& p) {
+        if (!met_[a * n_ + b]) {
+            met_[a * n_ + b] = 1;
+            met_point_[a * n_ + b] = p;
+        }
+    }
+
+    void find_contacts() {
+        // One rtree over the kept segments of every layer; ids follow (layer, segment) order.
+        std::vector<std::pair<std::size_t, std::size_t>> owner;
+        std::vector<Entry> entries;
+        for (std::size_t i = 0; i < n_; ++i)
+            for (std::size_t s : indices_[i].segments()) {
+                entries.emplace_back(segment_box(indices_[i].start(s), indices_[i].end(s)),
+                                     owner.size());
+                owner.emplace_back(i, s);
+            }
+        const Tree tree(entries.begin(), entries.end());
+
+        const std::size_t cap = params_.max_listed;
+        std::vector<Contact> proper_cross, proper_self, touches;
+        std::vector<Entry> hits;
+        for (std::size_t id = 0; id < owner.size(); ++id) {
+            const auto [i, s] = owner[id];
+            const SegmentIndex& a = indices_[i];
+            const Vec2 p0 = a.start(s), p1 = a.end(s);
+            hits.clear();
+            tree.query(bgi::intersects(segment_box(p0, p1)), std::back_inserter(hits));
+            std::sort(hits.begin(), hits.end(),
+                      [](const Entry& x, const Entry& y) { return x.second < y.second; });
+            for (const Entry& hit : hits) {
+                if (hit.second <= id) continue;
+                const auto [j, t] = owner[hit.second];
+                const SegmentIndex& b = indices_[j];
+                const Vec2 q0 = b.start(t), q1 = b.end(t);
+                if (i == j && (a.next(s) == t || a.next(t) == s)) {
+                    Vec2 point;
+                    if ((a.next(s) == t && folds_back(p0, p1, q1, point)) ||
+                        (a.next(t) == s && folds_back(q0, q1, p1, point)))
+                        touches.push_back({i, s, j, t, point, true});
+                    continue;
+                }
+                const SegmentContact contact = segment_contact(p0, p1, q0, q1);
+                if (contact == SegmentContact::None) continue;
+                if (contact == SegmentContact::Touch) {
+                    touches.push_back({i, s, j, t, touch_point(p0, p1, q0, q1), true});
+                    continue;
+                }
+                const Contact c{i, s, j, t, crossing_point(p0, p1, q0, q1), false};
+                if (i == j) {
+                    ++report_.self_crossing_count[i];
+                    if (proper_self.size() < cap) proper_self.push_back(c);
+                } else {
+                    ++report_.crossing_count;
+                    note_meeting(i, j, c.point);
+                    if (proper_cross.size() < cap) proper_cross.push_back(c);
+                }
+            }
+        }
+
+        // One contact location counts once: touches of the same two layers at the same
+        // representative point merge, keeping the lowest segment pair.
+        std::sort(touches.begin(), touches.end(), [](const Contact& x, const Contact& y) {
+            return std::tie(x.la, x.lb, x.point.x, x.point.y, x.sa, x.sb) <
+                   std::tie(y.la, y.lb, y.point.x, y.point.y, y.sa, y.sb);
+        });
+        touches.erase(std::unique(touches.begin(), touches.end(),
+                                  [](const Contact& x, const Contact& y) {
+                                      return x.la == y.la && x.lb == y.lb && x.point == y.point;
+                                  }),
+                      touches.end());
+        std::vector<Contact> cross_touches, self_touches;
+        for (const Contact& c : touches) {
+            if (c.la == c.lb) {
+                ++report_.self_crossing_count[c.la];
+                self_touches.push_back(c);
+            } else {
+                ++report_.crossing_count;
+                ++report_.touch_count;
+                note_meeting(c.la, c.lb, c.point);
+                cross_touches.push_back(c);
+            }
+        }
+        for (const Contact& c : merged_list(std::move(proper_cross), cross_touches, cap))
+            report_.crossings.push_back(to_crossing(c));
+        for (const Contact& c : merged_list(std::move(proper_self), self_touches, cap))
+            report_.self_crossings.push_back(to_crossing(c));
+    }
+
+    void find_separations() {
+        const double near = report_.near_distance;
+        const double tolerance = params_.separation_tolerance;
+        for (std::size_t i = 0; i < n_; ++i)
+            for (std::size_t j = i + 1; j < n_; ++j) {
+                const double required = scene_.required_separation(i, j);
+                const double threshold = required * (1.0 - tolerance);
+                const double cutoff = std::max(near, threshold);
+                if (!bounds_[i].inflated(cutoff).overlaps(bounds_[j])) continue;
+                const bool met = met_[i * n_ + j] != 0;
+                if (met && threshold <= 0.0) {
+                    add_pair(i, j, 0.0, required, met_point_[i * n_ + j], met_point_[i * n_ + j]);
+                    continue;
+                }
+                PairSeparation pair;
+                pair.gap = met ? 0.0 : kInf;
+                pair.at_a = pair.at_b = met_point_[i * n_ + j];
+                std::vector<SeparationViolation> violations;
+                auto scan = [&](std::size_t from, std::size_t to, bool from_is_a) {
+                    const std::vector<Vec2>& points = scene_.layer(from).points;
+                    for (std::size_t k = 0; k < points.size(); ++k) {
+                        const Nearest nr = nearest_on(indices_[to], points[k], cutoff);
+                        if (!nr.found()) continue;
+                        if (nr.distance < pair.gap) {
+                            pair.gap = nr.distance;
+                            pair.at_a = from_is_a ? points[k] : nr.point;
+                            pair.at_b = from_is_a ? nr.point : points[k];
+                        }
+                        if (nr.distance < threshold)
+                            violations.push_back({from, k, to, nr.distance, required});
+                    }
+                };
+                scan(i, j, true);
+                scan(j, i, false);
+                if (!(pair.gap < near)) continue;
+                add_pair(i, j, pair.gap, required, pair.at_a, pair.at_b);
+                report_.separation_violation_count += violations.size();
+                for (const SeparationViolation& v : violations)
+                    if (report_.separation_violations.size() < params_.max_listed)
+                        report_.separation_violations.push_back(v);
+            }
+    }
+
+    void add_pair(std::size_t i, std::size_t j, double gap, double required, const Vec2& at_a,
+                  const Vec2& at_b) {
+        PairSeparation pair;
+        pair.layer_a = i;
+        pair.layer_b = j;
+        pair.relation = scene_.relation(i, j);
+        pair.gap = gap;
+        pair.required = required;
+        pair.at_a = at_a;
+        pair.at_b = at_b;
+        if (required > 0.0)
+            report_.min_separation_ratio = std::min(report_.min_separation_ratio, pair.ratio());
+        report_.pairs.push_back(pair);
+    }
+
+    void find_nesting_violations() {
+        const double near = report_.near_distance;
+        std::vector<int> outside(n_, 0);
+        for (std::size_t b = 0; b < n_; ++b)
+            if (!scene_.layer(b).closed) outside[b] = open_outside(scene_, b, indices_[b], near);
+        for (std::size_t a = 0; a < n_; ++a)
+            for (std::size_t b = 0; b < n_; ++b) {
+                if (a == b) continue;
+                const Relation rel = scene_.relation(a, b);
+                const Layer& other = scene_.layer(b);
+                if (!other.closed && rel == Relation::SideBySide) continue;
+                if (!other.closed && !bounds_[a].overlaps(bounds_[b].inflated(near))) continue;
+                const std::vector<Vec2>& points = scene_.layer(a).points;
+                for (std::size_t k = 0; k < points.size(); ++k) {
+                    bool broken = false;
+                    if (other.closed) {
+                        const Placement where = placement(indices_[b], bounds_[b], points[k]);
+                        broken = rel == Relation::Under ? where == Placement::Outside
+                                                        : where == Placement::Inside;
+                    } else {
+                        const int side = side_at(indices_[b], points[k], near);
+                        broken = side != 0 && (rel == Relation::Under ? side == outside[b]
+                                                                      : side == -outside[b]);
+                    }
+                    if (!broken) continue;
+                    ++report_.nesting_violation_count;
+                    if (report_.nesting_violations.size() < params_.max_listed)
+                        report_.nesting_violations.push_back({a, k, b, rel});
+                }
+            }
+    }
+
+    const Scene& scene_;
+    const CheckParams& params_;
+    std::size_t n_ = 0;
+    std::vector<SegmentIndex> indices_;
+    std::vector<Box2> bounds_;
+    std::vector<char> met_;  // met_[a * n + b], a < b: the layers cross or touch
+    std::vector<Vec2> met_point_;
+    CheckReport report_;
+};
+
+// max over the points of `a` of the distance to `b`, by branch and bound (see hausdorff()).
+// An interval [p0, p1] of a segment of `a`, with nearest segments s0, s1 of `b` at its ends,
+// is bounded above by the 1-Lipschitz bound (d0 + d1 + L) / 2 and, since the distance to one
+// segment is convex along a line, by max(d(p0, s), d(p1, s)) for s = s0, s1. The second
+// bound settles parallel and receding stretches without splitting them to the tolerance.
+double one_sided_hausdorff(const Layer& a, const SegmentIndex& b, double tolerance) {
+    struct End {
+        Vec2 p;
+        double d;
+        std::size_t s;
+    };
+    struct Interval {
+        double upper;
+        End e0, e1;
+        bool operator<(const Interval& other) const { return upper < other.upper; }
+    };
+    auto evaluate = [&](const Vec2& p) {
+        const Nearest n = nearest_on(b, p);
+        return End{p, n.distance, n.segment};
+    };
+    auto to_segment = [&](const Vec2& p, std::size_t s) {
+        return point_segment_distance(p, b.start(s), b.end(s));
+    };
+    double lower = 0.0;
+    std::vector<Interval> heap;
+    auto push = [&](const End& e0, const End& e1) {
+        const double length = std::hypot(e1.p.x - e0.p.x, e1.p.y - e0.p.y);
+        double upper = 0.5 * (e0.d + e1.d + length);
+        upper = std::min(upper, std::max(e0.d, to_segment(e1.p, e0.s)));
+        upper = std::min(upper, std::max(e1.d, to_segment(e0.p, e1.s)));
+        if (upper > lower + tolerance) {
+            heap.push_back({upper, e0, e1});
+            std::push_heap(heap.begin(), heap.end());
+        }
+    };
+    std::vector<End> vertices;
+    vertices.reserve(a.points.size());
+    for (const Vec2& p : a.points) {
+        vertices.push_back(evaluate(p));
+        lower = std::max(lower, vertices.back().d);
+    }
+    const std::size_t count = a.segment_count();
+    for (std::size_t s = 0; s < count; ++s) push(vertices[s], vertices[(s + 1) % vertices.size()]);
+    while (!heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end());
+        const Interval top = heap.back();
+        heap.pop_back();
+        if (top.upper <= lower + tolerance) break;  // every other bound is lower still
+        const Vec2 mid = 0.5 * (top.e0.p + top.e1.p);
+        if (mid == top.e0.p || mid == top.e1.p) continue;  // no finer split in doubles
+        const End m = evaluate(mid);
+        lower = std::max(lower, m.d);
+        push(top.e0, m);
+        push(m, top.e1);
+    }
+    return lower;
+}
+
+void check_hausdorff_input(const Layer& layer, const char* which) {
+    if (layer.points.empty())
+        throw InvalidInput(std::string("hausdorff: layer ") + which + " ('" + layer.name +
+                           "') has no points");
+    for (std::size_t k = 0; k < layer.points.size(); ++k) {
+        const Vec2& p = layer.points[k];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y))
+            throw InvalidInput(std::string("hausdorff: layer ") + which + " ('" + layer.name +
+                               "'): point " + std::to_string(k) + " has a non-finite coordinate (" +
+                               format_number(p.x) + ", " + format_number(p.y) + ")");
+    }
+}
+
+// A layer as seen by the distance queries: a single point becomes one zero-length segment.
+Layer as_segments(const Layer& layer) {
+    Layer copy;
+    copy.name = layer.name;
+    copy.closed = layer.closed && layer.points.size() >= 3;
+    copy.points = layer.points;
+    if (copy.points.size() == 1) copy.points.push_back(copy.points.front());
+    return copy;
+}
+
+}  // namespace
+
+void validate(const CheckParams& params) {
+    if (!std::isfinite(params.near_distance) || params.near_distance < 0.0)
+        throw InvalidInput("check: params.near_distance must be a finite value >= 0 (got " +
+                           format_number(params.near_distance) + ")");
+    if (!std::isfinite(params.separation_tolerance) || params.separation_tolerance < 0.0 ||
+        params.separation_tolerance >= 1.0)
+        throw InvalidInput("check: params.separation_tolerance must be in [0, 1) (got " +
+                           format_number(params.separation_tolerance) + ")");
+}
+
+std::size_t CheckReport::total_self_crossings() const {
+    std::size_t total = 0;
+    for (std::size_t c : self_crossing_count) total += c;
+    return total;
+}
+
+bool CheckReport::is_collision_free() const {
+    return crossing_count == 0 && total_self_crossings() == 0 && nesting_violation_count == 0;
+}
+
+double automatic_near_distance(const Scene& scene) {
+    return automatic_near(scene);
+}
+
+CheckReport check_scene(const Scene& scene, const CheckParams& params) {
+    validate(params);
+    return Checker(scene, params).run();
+}
+
+int outside_side(const Scene& scene, std::size_t i, double near_distance) {
+    const Layer& layer = scene.layer(i);
+    if (layer.closed) return closed_outside(layer);
+    if (!std::isfinite(near_distance) || near_distance < 0.0)
+        throw InvalidInput("outside_side: near_distance must be a finite value >= 0 (got " +
+                           format_number(near_distance) + ")");
+    const double near = near_distance > 0.0 ? near_distance : automatic_near(scene);
+    return open_outside(scene, i, SegmentIndex(layer), near);
+}
+
+int outside_side(const Scene& scene, std::size_t i) {
+    return outside_side(scene, i, 0.0);
+}
+
+HausdorffDistance hausdorff(const Layer& a, const Layer& b, double tolerance) {
+    if (!std::isfinite(tolerance) || tolerance <= 0.0)
+        throw InvalidInput("hausdorff: tolerance must be a finite value > 0 (got " +
+                           format_number(tolerance) + ")");
+    check_hausdorff_input(a, "a");
+    check_hausdorff_input(b, "b");
+    const Layer sa = as_segments(a), sb = as_segments(b);
+    const SegmentIndex ia(sa), ib(sb);
+    HausdorffDistance result;
+    result.a_to_b = one_sided_hausdorff(sa, ib, tolerance);
+    result.b_to_a = one_sided_hausdorff(sb, ia, tolerance);
+    return result;
+}
+
+}  // namespace strata

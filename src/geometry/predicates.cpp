@@ -1,0 +1,113 @@
+#include "strata/geometry/predicates.h"
+
+// GCC 12 reports a false "maybe uninitialized" inside Boost.Multiprecision's rational type.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include <boost/multiprecision/cpp_int.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace strata {
+
+namespace {
+
+using Rational = boost::multiprecision::cpp_rational;
+
+// Shewchuk's bound for the first stage of orient2d: (3 + 16 eps) eps with eps = 2^-53.
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon() * 0.5;
+constexpr double kOrientBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+// Below this magnitude products may be subnormal and the relative bound no longer holds.
+constexpr double kTinyProduct = 1e-280;
+
+int sign_of(const Rational& value) {
+    return value > 0 ? 1 : (value < 0 ? -1 : 0);
+}
+
+int orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c) {
+    // Every double is a dyadic rational: the conversions and the arithmetic are exact.
+    const Rational acx = Rational(a.x) - Rational(c.x);
+    const Rational bcx = Rational(b.x) - Rational(c.x);
+    const Rational acy = Rational(a.y) - Rational(c.y);
+    const Rational bcy = Rational(b.y) - Rational(c.y);
+    return sign_of(acx * bcy - acy * bcx);
+}
+
+// Sign of x (-1, 0, +1), compared exactly.
+int sign_of(double x) {
+    return (x > 0.0) - (x < 0.0);
+}
+
+}  // namespace
+
+int orient2d(const Vec2& a, const Vec2& b, const Vec2& c) {
+    const double detleft = (a.x - c.x) * (b.y - c.y);
+    const double detright = (a.y - c.y) * (b.x - c.x);
+    const double det = detleft - detright;
+    const double detsum = std::fabs(detleft) + std::fabs(detright);
+    // Overflow, or products so small that underflow may have spoiled them: decide exactly.
+    if (!std::isfinite(det) || detsum < kTinyProduct) return orient2d_exact(a, b, c);
+    // Products of opposite signs (or one zero): the sign of det is exact.
+    if ((detleft >= 0.0) != (detright > 0.0) || detleft == 0.0) return sign_of(det);
+    const double bound = kOrientBound * detsum;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+    return orient2d_exact(a, b, c);
+}
+
+SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
+    // Quick reject on the bounding boxes (exact comparisons).
+    if (std::max(p0.x, p1.x) < std::min(q0.x, q1.x) ||
+        std::max(q0.x, q1.x) < std::min(p0.x, p1.x) ||
+        std::max(p0.y, p1.y) < std::min(q0.y, q1.y) || std::max(q0.y, q1.y) < std::min(p0.y, p1.y))
+        return SegmentContact::None;
+    const int o1 = orient2d(p0, p1, q0);
+    const int o2 = orient2d(p0, p1, q1);
+    if (o1 * o2 > 0) return SegmentContact::None;
+    const int o3 = orient2d(q0, q1, p0);
+    const int o4 = orient2d(q0, q1, p1);
+    if (o3 * o4 > 0) return SegmentContact::None;
+    if (o1 != 0 && o2 != 0 && o3 != 0 && o4 != 0) return SegmentContact::Proper;
+    if (o1 == 0 && o2 == 0 && o3 == 0 && o4 == 0) {
+        // All four points on one line (or degenerate segments): the boxes overlap, and on a
+        // line the box test is the interval test, so they share at least one point.
+        return SegmentContact::Touch;
+    }
+    // One end lies on the other segment's line, and the segments straddle each other's lines.
+    return SegmentContact::Touch;
+}
+
+Vec2 crossing_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
+    const Vec2 d = p1 - p0;
+    const Vec2 e = q1 - q0;
+    const double denom = d.x * e.y - d.y * e.x;
+    if (denom == 0.0) return p0;
+    const Vec2 w = q0 - p0;
+    const double t = std::clamp((w.x * e.y - w.y * e.x) / denom, 0.0, 1.0);
+    return p0 + t * d;
+}
+
+double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b, Vec2* closest) {
+    const Vec2 d = b - a;
+    const double len2 = d.x * d.x + d.y * d.y;
+    Vec2 c = a;
+    if (len2 > 0.0) {
+        const Vec2 w = p - a;
+        const double t = (w.x * d.x + w.y * d.y) / len2;
+        if (t >= 1.0)
+            c = b;
+        else if (t > 0.0)
+            c = a + t * d;
+    }
+    if (closest) *closest = c;
+    const double dx = p.x - c.x, dy = p.y - c.y;
+    return std::sqrt(dx * dx + dy * dy);
+}
+
+}  // namespace strata
