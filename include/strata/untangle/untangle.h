@@ -1,0 +1,91 @@
+#pragma once
+/// @file Shape-preserving implicit untangling (Gong, Parakkat & Rohmer 2023, sections 3-4, on
+/// Buffet et al. 2019 and Müller et al. 2005): vertices are projected onto the zero sets of the
+/// composed fields fhat_i, interleaved with shape matching, so that layers stop crossing and
+/// keep their order, separations and shapes.
+
+#include "strata/core/progress.h"
+#include "strata/field/field.h"
+#include "strata/geometry/scene.h"
+#include "strata/untangle/composition.h"
+#include "strata/untangle/localize.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace strata {
+
+/// What keeps a layer's shape between projection steps.
+enum class ShapeMode {
+    ShapeMatching,  ///< Müller-style quadratic shape matching per piece (the paper).
+    None,           ///< Pure projection (shows the artefacts of the paper's Fig. 2).
+};
+
+/// Parameters of untangle() and Untangler. Lengths are in scene units.
+struct UntangleParams {
+    int gradient_steps = 30;  ///< N_gd: projection steps per round (then one shape matching). >= 1.
+    double step = 0.5;        ///< dt: damping of each normalised projection step, (0, 1].
+    /// Each vertex step is clamped to this fraction of the shorter adjacent edge. (0, 1].
+    double max_step_fraction = 0.25;
+    /// Interior points tested on each edge, at least (1 = the midpoint): a chord between two
+    /// good vertices can still cut a neighbour. >= 0.
+    int edge_samples = 1;
+    /// Longer edges get more points, one every `sample_spacing` (scene units, >= 0), so that a
+    /// neighbour's vertex poking through a long chord is seen; at most 64 per edge.
+    /// 0 = automatic: the smallest per-layer median segment length (the finest layer's detail).
+    double sample_spacing = 0.0;
+    ShapeMode shape = ShapeMode::ShapeMatching;  ///< Shape preservation between projections.
+    double alpha = 0.8;  ///< Shape-matching stiffness for layers without their own, [0, 1].
+    double beta = 0.9;   ///< Quadratic share for layers without their own, [0, 1].
+    /// epsilon: a pass has converged when the mean displacement of the free vertices in the last
+    /// projection step of a round (V, Eq. 7) is <= tolerance * scene diagonal. > 0.
+    double tolerance = 1e-6;
+    int max_rounds = 60;  ///< Cap on rounds per pass. >= 1.
+    /// Passes: when a pass ends with the region still tangled, the fields are rebuilt from the
+    /// current geometry and the untangling runs again. >= 1.
+    int max_passes = 4;
+    /// Smallest separation the untangling aims for between any two constrained layers, scene
+    /// units, >= 0, used where the thicknesses ask for less: layers of zero thickness would
+    /// otherwise be projected onto each other and touch. 0 = automatic: 1% of the median
+    /// segment length of the scene, and with the grid backend at least a quarter voxel (the
+    /// grid cannot see a smaller gap through its interpolation error).
+    double min_separation = 0.0;
+    /// Guarantee: a separation passes when gap >= required * (1 - tol). [0, 1).
+    double separation_tolerance = 0.1;
+    FieldParams field;              ///< Field backend and resolution.
+    CompositionParams composition;  ///< Composition solver settings.
+};
+
+/// Throws InvalidInput naming the first out-of-range field.
+void validate(const UntangleParams& params);
+
+/// What an untangling did.
+struct UntangleReport {
+    int passes = 0;          ///< Passes run (fields built from the current geometry).
+    int rounds = 0;          ///< Rounds run, over all passes.
+    bool converged = false;  ///< The last pass met the tolerance before max_rounds.
+    bool collision_free =
+        false;  ///< Final exact check: no crossing, nesting kept, separations within tolerance.
+    std::size_t free_vertices = 0;   ///< Vertices allowed to move.
+    std::size_t moved_vertices = 0;  ///< Vertices that moved by more than 1e-12 * diagonal.
+    double max_displacement = 0.0;   ///< Largest distance of a vertex from its start, scene units.
+    double mean_speed = 0.0;         ///< Last round's V (Eq. 7), scene units per step.
+    std::size_t crossings_before = 0, crossings_after = 0;  ///< Between layers (check_scene).
+    double min_separation_ratio_after = 0.0;  ///< check_scene's, +inf when nothing is required.
+    double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
+};
+
+/// @brief Untangles the whole scene (the global mode): every vertex may move.
+/// @param scene     modified in place; unchanged on throw.
+/// @param progress  called once per round ("untangle", fraction); false cancels (throws Cancelled).
+/// @throws InvalidInput bad params.  @throws Cancelled.
+UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
+                        const ProgressFn& progress = {});
+
+/// @brief Untangles only the vertices of `scene` inside `box`, with collars of `n_out` fixed
+/// vertices (localize()). The fields are built for whole layers here; the simplification
+/// driver keeps them and updates them only inside its boxes.
+UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out = 7,
+                              const UntangleParams& params = {}, const ProgressFn& progress = {});
+
+}  // namespace strata

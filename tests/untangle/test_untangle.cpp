@@ -1,0 +1,167 @@
+#include "strata/core/error.h"
+#include "strata/geometry/checks.h"
+#include "strata/io/json_io.h"
+#include "strata/untangle/untangle.h"
+#include "support/fixtures.h"
+
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+using namespace strata;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Layer circle(std::string name, Vec2 centre, double r, std::size_t n, double thickness = 0.0) {
+    Layer layer;
+    layer.name = std::move(name);
+    layer.closed = true;
+    layer.thickness = thickness;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double t = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(n);
+        layer.points.push_back(centre + r * Vec2(std::cos(t), std::sin(t)));
+    }
+    return layer;
+}
+
+double max_move(const Scene& a, const Scene& b, std::size_t layer) {
+    double d = 0.0;
+    for (std::size_t v = 0; v < a.layer(layer).points.size(); ++v)
+        d = std::max(d, glm::distance(a.layer(layer).points[v], b.layer(layer).points[v]));
+    return d;
+}
+
+void require_untangled(const Scene& scene, double tol = 0.1) {
+    CheckParams params;
+    params.separation_tolerance = tol;
+    const CheckReport check = check_scene(scene, params);
+    CHECK(check.crossing_count == 0);
+    CHECK(check.total_self_crossings() == 0);
+    CHECK(check.nesting_violation_count == 0);
+    CHECK(check.separation_violation_count == 0);
+}
+
+UntangleParams exact_params() {
+    UntangleParams params;
+    params.field.backend = FieldBackend::ExactIndexed;
+    return params;
+}
+
+}  // namespace
+
+TEST_CASE("an inner circle poking out of its outer circle is pulled back in", "[untangle]") {
+    for (FieldBackend backend :
+         {FieldBackend::Grid, FieldBackend::ExactIndexed, FieldBackend::ExactBrute}) {
+        Scene scene(
+            {circle("inner", {0.3, 0.0}, 1.0, 64, 0.05), circle("outer", {0, 0}, 1.2, 64, 0.05)});
+        REQUIRE(check_scene(scene).crossing_count == 2);
+        UntangleParams params;
+        params.field.backend = backend;
+        const UntangleReport report = untangle(scene, params);
+        CHECK(report.crossings_before == 2);
+        CHECK(report.crossings_after == 0);
+        CHECK(report.collision_free);
+        require_untangled(scene);
+    }
+}
+
+TEST_CASE("a much heavier layer barely moves", "[untangle]") {
+    Scene light({circle("inner", {0.3, 0.0}, 1.0, 64), circle("outer", {0, 0}, 1.2, 64)});
+    std::vector<Layer> layers = light.layers();
+    layers[1].weight = 1000.0;
+    Scene heavy(layers);
+    const Scene before = heavy;
+    untangle(light, exact_params());
+    untangle(heavy, exact_params());
+    require_untangled(heavy);
+    CHECK(max_move(heavy, before, 1) < 0.05 * max_move(light, before, 1));
+    CHECK(max_move(heavy, before, 0) > 0.09);  // the inner one made the room instead
+}
+
+TEST_CASE("stacked open layers keep order and separation", "[untangle]") {
+    // Five stacked sines with thickness 0.1; the middle one is pushed down through two others.
+    const Scene stack = test::stacked_sines(5, 120, 0.3, 0.25, 0.1);
+    std::vector<Layer> layers = stack.layers();
+    for (Vec2& p : layers[2].points)
+        if (p.x > 4.0 && p.x < 7.0) p.y -= 0.6 * std::sin((p.x - 4.0) * kPi / 3.0);
+    Scene scene(layers);
+    REQUIRE(check_scene(scene).crossing_count > 0);
+    const UntangleReport report = untangle(scene, exact_params());
+    CHECK(report.collision_free);
+    require_untangled(scene);
+}
+
+TEST_CASE("two loops side by side inside a third stay apart and inside", "[untangle]") {
+    auto with_outer = [](Layer l, std::vector<std::string> outer) {
+        l.outer = std::move(outer);
+        return l;
+    };
+    Scene scene({with_outer(circle("leg_l", {-0.45, 0}, 0.6, 48, 0.02), {"skirt"}),
+                 with_outer(circle("leg_r", {0.45, 0}, 0.6, 48, 0.02), {"skirt"}),
+                 with_outer(circle("skirt", {0, 0}, 1.0, 96, 0.02), {})});
+    const CheckReport before = check_scene(scene);
+    REQUIRE(before.crossing_count > 0);  // the legs overlap each other and poke out
+    const UntangleReport report = untangle(scene, exact_params());
+    CHECK(report.collision_free);
+    require_untangled(scene);
+}
+
+TEST_CASE("pure projection also untangles but does not keep the shape as well", "[untangle]") {
+    Scene scene({circle("inner", {0.3, 0.0}, 1.0, 64), circle("outer", {0, 0}, 1.2, 64)});
+    UntangleParams params = exact_params();
+    params.shape = ShapeMode::None;
+    const UntangleReport report = untangle(scene, params);
+    CHECK(report.collision_free);
+}
+
+TEST_CASE("local untangling moves nothing outside the box", "[untangle][localize]") {
+    Scene scene({circle("inner", {0.3, 0.0}, 1.0, 64), circle("outer", {0, 0}, 1.2, 64)});
+    const Scene before = scene;
+    const Box2 box{{0.8, -0.9}, {1.5, 0.9}};
+    const UntangleReport report = untangle_local(scene, box, 7, exact_params());
+    CHECK(report.collision_free);
+    for (std::size_t l = 0; l < scene.size(); ++l)
+        for (std::size_t v = 0; v < scene.layer(l).points.size(); ++v)
+            if (!box.contains(before.layer(l).points[v]))
+                CHECK(scene.layer(l).points[v] == before.layer(l).points[v]);
+}
+
+TEST_CASE("naive decimation of real slices is untangled", "[untangle][slices]") {
+    for (const char* name : {"mh_elegantsuit01_y+0.50.json", "mh_casualsuit03_y+1.50.json",
+                             "cipc_multilayer_y+0.00.json"}) {
+        INFO(name);
+        const Scene input = read_scene_json(test::test_data(std::string("slices/") + name));
+        // Keep every third vertex (ends of open layers kept): a naive decimation.
+        std::vector<Layer> layers = input.layers();
+        for (Layer& l : layers) {
+            std::vector<Vec2> kept;
+            for (std::size_t i = 0; i < l.points.size(); ++i)
+                if (i % 3 == 0 || (!l.closed && i + 1 == l.points.size()))
+                    kept.push_back(l.points[i]);
+            l.points = kept;
+        }
+        Scene scene(layers);
+        const CheckReport naive = check_scene(scene);
+        UNSCOPED_INFO("naive crossings " << naive.crossing_count << ", nesting "
+                                         << naive.nesting_violation_count);
+        const UntangleReport report = untangle(scene, exact_params());
+        CHECK(report.collision_free);
+        const CheckReport after = check_scene(scene);
+        CHECK(after.crossing_count == 0);
+        CHECK(after.nesting_violation_count == 0);
+    }
+}
+
+TEST_CASE("bad untangle parameters are rejected by name", "[untangle]") {
+    Scene scene = test::nested_circles(2, 16);
+    UntangleParams params;
+    params.step = 0.0;
+    CHECK_THROWS_WITH(untangle(scene, params),
+                      Catch::Contains("params.step") && Catch::Contains("got 0"));
+    params = {};
+    params.alpha = 2.0;
+    CHECK_THROWS_WITH(untangle(scene, params), Catch::Contains("params.alpha"));
+}
