@@ -1,0 +1,56 @@
+#pragma once
+/// @file The untangling engine shared by untangle() and the simplification driver: passes of
+/// projection + shape matching over fields built from a work scene whose layers may stand for
+/// layers (or parts of layers) of another scene.
+
+#include "strata/untangle/untangle.h"
+
+#include <functional>
+#include <vector>
+
+namespace strata::detail {
+
+/// Where the layers of a work scene take their nesting, separations and weights from.
+struct RelationSource {
+    const Scene* scene = nullptr;     ///< The scene that holds the nesting.
+    std::vector<std::size_t> parent;  ///< Work layer -> layer of `scene`; empty: identity.
+
+    std::size_t of(std::size_t i) const { return parent.empty() ? i : parent[i]; }
+    /// Parts of one layer do not constrain each other.
+    Relation relation(std::size_t a, std::size_t b) const {
+        return of(a) == of(b) ? Relation::Same : scene->relation(of(a), of(b));
+    }
+    double separation(std::size_t a, std::size_t b) const {
+        return of(a) == of(b) ? 0.0 : scene->required_separation(of(a), of(b));
+    }
+    double weight(std::size_t a) const { return scene->layer(of(a)).weight; }
+};
+
+/// Scene-wide settings of the engine, resolved once.
+struct EngineSettings {
+    double min_separation = 0.0;     ///< Resolved UntangleParams::min_separation (> 0).
+    double sample_spacing = 0.0;     ///< Resolved UntangleParams::sample_spacing.
+    std::vector<int> outside_signs;  ///< Per work layer, see outside_side().
+    double diagonal = 1.0;           ///< Scene scale for the tolerance.
+};
+
+/// What run_engine() did.
+struct EngineResult {
+    int passes = 0, rounds = 0;
+    bool converged = false;  ///< The last pass met the tolerance.
+    bool ok = false;         ///< is_ok(work) held at the end.
+    double mean_speed = 0.0;
+    double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
+};
+
+/// Resolves the automatic min_separation and sample_spacing from `scene` and the params.
+EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params);
+
+/// Runs passes (fields built from `work` at the start of each) until is_ok(work) holds or
+/// params.max_passes is reached. Only the free vertices of `pieces` move.
+/// @throws Cancelled when `progress` returns false (work is then partly moved).
+EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const UntangleParams& params,
+                        const RelationSource& relations, const EngineSettings& settings,
+                        const std::function<bool(const Scene&)>& is_ok, const ProgressFn& progress);
+
+}  // namespace strata::detail
