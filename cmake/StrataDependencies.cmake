@@ -7,6 +7,8 @@ find_package(nlohmann_json 3.2 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(tinyxml2 REQUIRED)
 find_package(Boost 1.74 REQUIRED)
+# OpenMesh (Debian libopenmesh-dev 9.0 ships a config without a version file): OpenMeshCore.
+find_package(OpenMesh REQUIRED)
 
 # Debian ships OpenVDB's FindOpenVDB.cmake (no config package) under lib/<arch>/cmake/OpenVDB.
 if(CMAKE_LIBRARY_ARCHITECTURE)

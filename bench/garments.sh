@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Slices every garment of ../shared/data/garments with its body at regular heights and runs
+# `strata check` on every slice; prints one summary row per outfit.
+#
+#   bench/garments.sh [OUT_DIR]          (from the repository root, after building strata_cli)
+#
+# MakeHuman outfits (decimetres): body + suit, every 0.5 dm over their height, --order body,suit.
+# Codim-IPC skirt (metres): split into components, every 0.05 m (the same 0.5 dm).
+# Environment: STRATA (the strata binary), DATA (the garments folder).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+strata=${STRATA:-$root/build/tools/strata}
+data=${DATA:-$root/../shared/data/garments}
+out=${1:-$root/build/bench/garments}
+[ -x "$strata" ] || { echo "garments.sh: no strata binary at $strata (build strata_cli)" >&2; exit 2; }
+[ -d "$data" ] || { echo "garments.sh: no garments folder at $data" >&2; exit 2; }
+mkdir -p "$out"
+
+# slice_outfit NAME STEP STRATA-SLICE-ARGS...
+rows=()
+slice_outfit() {
+  local name=$1 step=$2
+  shift 2
+  rm -rf "${out:?}/$name"
+  local t0=$SECONDS
+  "$strata" slice "$@" --every "$step" --prefix "$name" -o "$out/$name" > "$out/$name.slice.log" 2> "$out/$name.slice.err"
+  local slices=0 layers=0 vertices=0 crossing=0 nesting=0 links=0
+  while IFS= read -r line; do
+    links=$((links + $(sed -E 's/.* ([0-9]+) nesting links.*/\1/' <<< "$line")))
+  done < <(grep ' nesting links' "$out/$name.slice.log")
+  for f in "$out/$name"/*.json; do
+    local report
+    report=$("$strata" check "$f" 2>/dev/null || true)
+    slices=$((slices + 1))
+    layers=$((layers + $(head -1 <<< "$report" | sed -E 's/.*: ([0-9]+) layers, ([0-9]+) vertices.*/\1/')))
+    vertices=$((vertices + $(head -1 <<< "$report" | sed -E 's/.*: ([0-9]+) layers, ([0-9]+) vertices.*/\2/')))
+    local x s
+    x=$(sed -nE 's/^crossings between layers: ([0-9]+).*/\1/p' <<< "$report")
+    s=$(sed -nE 's/^self-crossings: ([0-9]+).*/\1/p' <<< "$report")
+    if [ "$x" -gt 0 ] || [ "$s" -gt 0 ]; then
+      crossing=$((crossing + 1))
+    elif ! grep -q '^nesting: holds' <<< "$report"; then
+      nesting=$((nesting + 1))
+    fi
+  done
+  rows+=("$(printf '%-20s %6d %7d %9d %7d %10d %9d %6ds' "$name" "$slices" "$layers" "$vertices" "$links" \
+            "$crossing" "$nesting" $((SECONDS - t0)))")
+}
+
+mh=$data/makehuman
+for suit in casualsuit03 casualsuit05 elegantsuit01; do
+  slice_outfit "mh_$suit" 0.5 "body=$mh/male_generic.obj" "suit=$mh/male_$suit.obj" --order body,suit --units dm
+done
+slice_outfit cipc_multilayer 0.05 "skirt=$data/codim-ipc/multilayer_drape.obj" --components --units m
+
+printf '%-20s %6s %7s %9s %7s %10s %9s %7s\n' outfit slices layers vertices links "crossing" "nest-viol" time
+for r in "${rows[@]}"; do echo "$r"; done
+echo "crossing: slices whose input already crosses (strata check: crossings or self-crossings > 0)"
+echo "nest-viol: crossing-free slices whose inferred nesting strata check rejects"
+echo "slices in $out"
