@@ -1,4 +1,5 @@
 #include "field/detail/grid_inspect.h"
+#include "field/detail/segment_store.h"
 #include "strata/core/error.h"
 #include "strata/field/field.h"
 #include "strata/io/json_io.h"
@@ -442,6 +443,75 @@ TEST_CASE("localized updates equal a full rebuild", "[field]") {
         }
         CHECK(grid->stats().segments == layer.segment_count());
     }
+}
+
+TEST_CASE("the blocked slot sequence splices like a vector", "[field]") {
+    // Enough entries for several blocks; edits that empty blocks, split them and touch the ends.
+    detail::SlotSequence seq;
+    std::vector<std::uint32_t> ref(5000);
+    seq.assign(ref.size());
+    for (std::size_t i = 0; i < ref.size(); ++i) ref[i] = static_cast<std::uint32_t>(i);
+    std::mt19937 rng(17);
+    std::uint32_t next = 100000;
+    std::vector<std::uint32_t> got;
+    for (int step = 0; step < 3000; ++step) {
+        std::uniform_int_distribution<std::size_t> at(0, ref.size());
+        const std::size_t first = at(rng);
+        std::size_t count =
+            std::min<std::size_t>(ref.size() - first, static_cast<std::size_t>(step % 5));
+        std::size_t inserted = static_cast<std::size_t>(step % 7);
+        if (step % 500 == 250) count = std::min<std::size_t>(ref.size() - first, 1500);
+        if (step % 500 == 0) inserted = 2500;
+        if (ref.size() < 100) inserted += 50;
+        std::vector<std::uint32_t> values(inserted);
+        for (auto& v : values) v = next++;
+        seq.replace(first, count, values);
+        ref.erase(ref.begin() + static_cast<std::ptrdiff_t>(first),
+                  ref.begin() + static_cast<std::ptrdiff_t>(first + count));
+        ref.insert(ref.begin() + static_cast<std::ptrdiff_t>(first), values.begin(), values.end());
+        REQUIRE(seq.size() == ref.size());
+        const std::size_t probe = std::min<std::size_t>(first, ref.size() - 1);
+        const std::size_t len = std::min<std::size_t>(ref.size() - probe, 9);
+        seq.read(probe, len, got);
+        REQUIRE(
+            std::equal(got.begin(), got.end(), ref.begin() + static_cast<std::ptrdiff_t>(probe)));
+    }
+    seq.read(0, ref.size(), got);
+    CHECK(got == ref);
+    seq.replace(0, ref.size(), {});
+    CHECK(seq.size() == 0);
+    seq.replace(0, 0, {7, 8});
+    seq.read(0, 2, got);
+    CHECK(got == std::vector<std::uint32_t>{7, 8});
+}
+
+TEST_CASE("localized updates equal a full rebuild on a layer of several index blocks", "[field]") {
+    // 6000 segments: the segment index spans several blocks of the slot sequence.
+    std::mt19937 rng(31);
+    Layer layer = random_star(rng, 6000, false);
+    const Scene scene({layer});
+    const ResolvedFieldParams p = resolve({}, scene);
+    auto grid = make_field(layer, 1, with_backend(p, FieldBackend::Grid));
+    auto indexed = make_field(layer, 1, with_backend(p, FieldBackend::ExactIndexed));
+    for (int step = 0; step < 200; ++step) {
+        const PolylineEdit edit = random_edit(rng, layer.points, 0.002);
+        grid->update(layer.points, edit);
+        indexed->update(layer.points, edit);
+    }
+    const auto fresh = make_field(layer, 1, with_backend(p, FieldBackend::Grid));
+    std::string why;
+    CHECK(detail::grids_identical(*grid, *fresh, &why));
+    INFO(why);
+    const auto brute = make_field(layer, 1, with_backend(p, FieldBackend::ExactBrute));
+    std::uniform_real_distribution<double> u(-1.5, 1.5);
+    std::size_t differ = 0;
+    for (int q = 0; q < 500; ++q) {
+        const Vec2 x(u(rng), u(rng));
+        const FieldSample a = brute->sample(x), b = indexed->sample(x);
+        if (a.value != b.value || a.gradient != b.gradient) ++differ;
+    }
+    CHECK(differ == 0);
+    CHECK(grid->stats().segments == layer.segment_count());
 }
 
 TEST_CASE("bad edits throw and leave the field unchanged", "[field]") {

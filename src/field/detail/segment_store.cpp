@@ -5,12 +5,15 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 namespace strata::detail {
 
 namespace {
+
+constexpr std::size_t kSpareSlots = 64;  // more than any local edit needs at once
 
 double cross(const Vec2& a, const Vec2& b) {
     return a.x * b.y - a.y * b.x;
@@ -82,6 +85,121 @@ void SegmentStore::update_ends(const std::vector<Vec2>& points) {
     end_t_[1] = unit_or_zero(points[n - 1] - points[n - 2]);
 }
 
+void SlotSequence::assign(std::size_t n) {
+    blocks_.clear();
+    size_ = n;
+    for (std::size_t first = 0; first < n; first += kBlock) {
+        std::vector<std::uint32_t>& block = blocks_.emplace_back(std::min(kBlock, n - first));
+        for (std::size_t k = 0; k < block.size(); ++k)
+            block[k] = static_cast<std::uint32_t>(first + k);
+    }
+    rebuild_sums();
+}
+
+void SlotSequence::rebuild_sums() {
+    const std::size_t count = blocks_.size();
+    sums_.assign(count + 1, 0);
+    for (std::size_t i = 1; i <= count; ++i) {
+        sums_[i] += blocks_[i - 1].size();
+        const std::size_t parent = i + (i & (~i + 1));
+        if (parent <= count) sums_[parent] += sums_[i];
+    }
+}
+
+void SlotSequence::add_to_sums(std::size_t block, std::size_t count) {
+    for (std::size_t i = block + 1; i < sums_.size(); i += i & (~i + 1)) sums_[i] += count;
+}
+
+void SlotSequence::remove_from_sums(std::size_t block, std::size_t count) {
+    for (std::size_t i = block + 1; i < sums_.size(); i += i & (~i + 1)) sums_[i] -= count;
+}
+
+void SlotSequence::locate(std::size_t k, std::size_t& block, std::size_t& offset) const {
+    const std::size_t count = blocks_.size();
+    std::size_t step = 1;
+    while (2 * step <= count) step *= 2;
+    std::size_t pos = 0, rest = k;
+    for (; step > 0; step /= 2)
+        if (pos + step <= count && sums_[pos + step] <= rest) {
+            pos += step;
+            rest -= sums_[pos];
+        }
+    // pos blocks hold at most k entries; pos == count only for k == size().
+    if (pos == count && count > 0) {
+        block = count - 1;
+        offset = blocks_[block].size();
+    } else {
+        block = pos;
+        offset = rest;
+    }
+}
+
+void SlotSequence::read(std::size_t first, std::size_t count,
+                        std::vector<std::uint32_t>& out) const {
+    out.clear();
+    if (count == 0) return;
+    std::size_t b = 0, off = 0;
+    locate(first, b, off);
+    while (out.size() < count) {
+        out.push_back(blocks_[b][off]);
+        if (++off == blocks_[b].size()) {
+            ++b;
+            off = 0;
+        }
+    }
+}
+
+void SlotSequence::replace(std::size_t first, std::size_t count,
+                           const std::vector<std::uint32_t>& values) {
+    std::size_t b = 0, off = 0;
+    if (count > 0) locate(first, b, off);
+    bool reshaped = false;
+    for (std::size_t left = count; left > 0;) {
+        std::vector<std::uint32_t>& block = blocks_[b];
+        const std::size_t m = std::min(left, block.size() - off);
+        const auto at = block.begin() + static_cast<std::ptrdiff_t>(off);
+        block.erase(at, at + static_cast<std::ptrdiff_t>(m));
+        left -= m;
+        size_ -= m;
+        if (block.empty()) {
+            blocks_.erase(blocks_.begin() + static_cast<std::ptrdiff_t>(b));
+            reshaped = true;
+        } else {
+            if (!reshaped) remove_from_sums(b, m);
+            if (off == block.size()) {
+                ++b;
+                off = 0;
+            }
+        }
+    }
+    if (reshaped) rebuild_sums();
+    if (values.empty()) return;
+    if (blocks_.empty()) {
+        blocks_.emplace_back();
+        rebuild_sums();
+    }
+    locate(first, b, off);
+    std::vector<std::uint32_t>& block = blocks_[b];
+    block.insert(block.begin() + static_cast<std::ptrdiff_t>(off), values.begin(), values.end());
+    size_ += values.size();
+    if (block.size() > 2 * kBlock) {
+        const auto half = block.begin() + static_cast<std::ptrdiff_t>(block.size() / 2);
+        std::vector<std::uint32_t> tail(half, block.end());
+        block.erase(half, block.end());
+        blocks_.insert(blocks_.begin() + static_cast<std::ptrdiff_t>(b + 1), std::move(tail));
+        rebuild_sums();
+    } else {
+        add_to_sums(b, values.size());
+    }
+}
+
+std::size_t SlotSequence::memory_bytes() const {
+    std::size_t bytes = blocks_.capacity() * sizeof(std::vector<std::uint32_t>) +
+                        sums_.capacity() * sizeof(std::size_t);
+    for (const auto& block : blocks_) bytes += block.capacity() * sizeof(std::uint32_t);
+    return bytes;
+}
+
 std::uint32_t SegmentStore::allocate() {
     if (!free_.empty()) {
         const std::uint32_t slot = free_.back();
@@ -106,12 +224,11 @@ void SegmentStore::build(const std::vector<Vec2>& points, bool closed, int outsi
     }
     segments_.clear();
     free_.clear();
-    slot_of_.resize(segs);
-    segments_.reserve(segs);
-    for (std::size_t i = 0; i < segs; ++i) {
-        segments_.push_back(make_segment(points, i));
-        slot_of_[i] = static_cast<std::uint32_t>(i);
-    }
+    slot_of_.assign(segs);
+    // Headroom: an edit allocates the new slots before it frees the old ones (their geometry is
+    // read afterwards), so without it the first edit after a build would copy every segment.
+    segments_.reserve(segs + kSpareSlots);
+    for (std::size_t i = 0; i < segs; ++i) segments_.push_back(make_segment(points, i));
     update_ends(points);
 }
 
@@ -156,11 +273,14 @@ bool SegmentStore::splice(const std::vector<Vec2>& points, const PolylineEdit& e
         hi_old = std::min(hi_old, segs_old - 1);
         hi_new = std::min(hi_new, segs_new - 1);
     }
+    std::vector<std::uint32_t> old_slots;
+    slot_of_.read(static_cast<std::size_t>(lo), static_cast<std::size_t>(hi_old - lo + 1),
+                  old_slots);
     if (closed_) {
         double area = twice_area_;
         const auto n = points.size();
-        for (long k = lo; k <= hi_old; ++k) {
-            const Segment& s = segments_[slot_of_[static_cast<std::size_t>(k)]];
+        for (const std::uint32_t slot : old_slots) {
+            const Segment& s = segments_[slot];
             area -= cross(s.a, s.b);
         }
         for (long k = lo; k <= hi_new; ++k) {
@@ -175,14 +295,11 @@ bool SegmentStore::splice(const std::vector<Vec2>& points, const PolylineEdit& e
         segments_[slot] = make_segment(points, static_cast<std::size_t>(k));
         added.push_back(slot);
     }
-    for (long k = lo; k <= hi_old; ++k) {
-        const std::uint32_t slot = slot_of_[static_cast<std::size_t>(k)];
+    for (const std::uint32_t slot : old_slots) {
         segments_[slot].live = false;
         removed.push_back(slot);
     }
-    const auto first = slot_of_.begin() + lo;
-    slot_of_.erase(first, slot_of_.begin() + hi_old + 1);
-    slot_of_.insert(slot_of_.begin() + lo, added.begin(), added.end());
+    slot_of_.replace(static_cast<std::size_t>(lo), old_slots.size(), added);
     free_.insert(free_.end(), removed.begin(), removed.end());
     update_ends(points);
     return true;
