@@ -29,7 +29,7 @@ TEST_CASE("an open layer's run is extended by n_out, clamped at the ends", "[unt
     CHECK(start[0].vertices == range(0, 8));
 }
 
-TEST_CASE("a layer entering the box twice gives two pieces; near runs merge",
+TEST_CASE("a layer entering the box twice gives two pieces, near runs merge",
           "[untangle][localize]") {
     const Scene scene = test::stacked_sines(1, 101, 1.0, 1.0);  // y = sin x over [0, 4 pi]
     // The band y > 0.9 holds two separate runs (around x = pi/2 and 5 pi/2).

@@ -1,0 +1,86 @@
+#pragma once
+/// @file Collision-free simplification (Gong, Parakkat & Rohmer 2023, Algorithm 1): vertex
+/// decimation, and after each removal that makes layers cross or come too close, a localized
+/// untangling; a removal that cannot be made collision-free is rolled back.
+
+#include "strata/core/progress.h"
+#include "strata/geometry/scene.h"
+#include "strata/untangle/untangle.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace strata {
+
+/// Parameters of simplify(). Lengths are in scene units.
+struct SimplifyParams {
+    /// "random" (the paper's experiments), "visvalingam" or "max-error"; see decimator.h.
+    std::string decimator = "visvalingam";
+    /// Fraction of each layer's vertices to remove, [0, 1]. Ignored when `keep` > 0.
+    double remove = 0.9;
+    /// Vertices to keep per layer (0: use `remove`).
+    std::size_t keep = 0;
+    /// > 0: never remove a vertex whose removal leaves an input vertex farther than this from
+    /// the simplified layer (span_error()); with `remove` = 1 this is the target itself.
+    double max_error = 0.0;
+    std::uint64_t seed = 1;  ///< Seed of the random decimator.
+    bool untangle = true;    ///< false: naive decimation (the paper's left-hand images).
+    bool global = false;     ///< Untangle the whole scene instead of a box (for comparison).
+    std::size_t n_out = 7;   ///< N_out: fixed collar vertices on both sides of a piece.
+    /// Untangling settings. Defaults differ from untangle()'s: fewer rounds and passes, since
+    /// a step that does not untangle quickly is rolled back.
+    UntangleParams untangling = default_untangling();
+
+    static UntangleParams default_untangling() {
+        UntangleParams p;
+        p.max_rounds = 8;
+        p.max_passes = 2;
+        p.field.backend = FieldBackend::ExactIndexed;
+        return p;
+    }
+};
+
+/// Throws InvalidInput naming the first out-of-range field.
+void validate(const SimplifyParams& params);
+
+/// Per-layer outcome.
+struct LayerSimplifyReport {
+    std::string name;
+    std::size_t before = 0, after = 0, target = 0;  ///< Vertex counts.
+    std::size_t refused = 0;        ///< Removals rolled back (their vertex is kept).
+    std::size_t untangled = 0;      ///< Removals that needed a local untangling.
+    double hausdorff = 0.0;         ///< Symmetric Hausdorff distance to the input layer.
+    double max_displacement = 0.0;  ///< Largest move of a kept vertex.
+};
+
+/// What simplify() did.
+struct SimplifyReport {
+    std::vector<LayerSimplifyReport> layers;
+    std::size_t removed = 0;         ///< Removals kept.
+    std::size_t untangle_calls = 0;  ///< Local untanglings run.
+    std::size_t refused = 0;         ///< Removals rolled back.
+    int rounds = 0;                  ///< Untangling rounds over all calls.
+    bool targets_met = true;         ///< Every layer reached its target.
+    // Final exact check of the whole output (check_scene()).
+    std::size_t crossings = 0, self_crossings = 0, nesting_violations = 0;
+    double min_separation_ratio = 0.0;  ///< +inf when nothing is required.
+    bool collision_free = false;
+    double seconds_decimate = 0.0, seconds_fields = 0.0, seconds_untangle = 0.0,
+           seconds_check = 0.0, seconds_total = 0.0;
+};
+
+/// @brief Simplifies `scene` in place to the targets of `params`, keeping it collision-free
+/// when params.untangle is set (see the file comment); open layers keep their end vertices
+/// (never removed nor moved), closed layers at least 3 vertices.
+/// @param progress  ("simplify", fraction of the removals done); false cancels.
+/// @throws InvalidInput bad params.  @throws Cancelled (scene unchanged).
+SimplifyReport simplify(Scene& scene, const SimplifyParams& params = {},
+                        const ProgressFn& progress = {});
+
+/// The built-in demo: five stacked cloth-like open layers with folds (after the paper's
+/// Fig. 1), `points` vertices each, thickness 0.01, innermost first, one implicit stack.
+Scene demo_scene(std::size_t points = 600);
+
+}  // namespace strata

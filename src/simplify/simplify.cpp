@@ -1,0 +1,671 @@
+#include "strata/simplify/simplify.h"
+
+#include "strata/core/error.h"
+#include "strata/core/format.h"
+#include "strata/geometry/checks.h"
+#include "strata/geometry/predicates.h"
+#include "strata/simplify/decimator.h"
+#include "untangle/detail/engine.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <unordered_map>
+
+namespace strata {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct SegRef {
+    std::uint32_t layer = 0, start = 0;  // segment from vertex `start` to its next alive vertex
+};
+
+// Uniform hash grid of segments (by bounding box), updated as vertices move or go.
+class SegmentGrid {
+  public:
+    explicit SegmentGrid(double cell) : cell_(cell) {}
+
+    void insert(SegRef s, const Box2& box) {
+        for_cells(box, [&](std::uint64_t key) { cells_[key].push_back(s); });
+    }
+    void erase(SegRef s, const Box2& box) {
+        for_cells(box, [&](std::uint64_t key) {
+            auto it = cells_.find(key);
+            if (it == cells_.end()) return;
+            auto& v = it->second;
+            for (std::size_t i = 0; i < v.size(); ++i)
+                if (v[i].layer == s.layer && v[i].start == s.start) {
+                    v[i] = v.back();
+                    v.pop_back();
+                    break;
+                }
+        });
+    }
+    // Calls f(SegRef) for the segments of the cells `box` touches (with repeats).
+    template <class F>
+    void query(const Box2& box, F&& f) const {
+        for_cells(box, [&](std::uint64_t key) {
+            auto it = cells_.find(key);
+            if (it == cells_.end()) return;
+            for (const SegRef& s : it->second) f(s);
+        });
+    }
+
+  private:
+    template <class F>
+    void for_cells(const Box2& box, F&& f) const {
+        const auto x0 = coord(box.min.x), x1 = coord(box.max.x);
+        const auto y0 = coord(box.min.y), y1 = coord(box.max.y);
+        for (auto ix = x0; ix <= x1; ++ix)
+            for (auto iy = y0; iy <= y1; ++iy)
+                f((static_cast<std::uint64_t>(ix) << 32) ^
+                  (static_cast<std::uint64_t>(iy) & 0xffffffffULL));
+    }
+    long long coord(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
+
+    double cell_;
+    std::unordered_map<std::uint64_t, std::vector<SegRef>> cells_;
+};
+
+// A layer being decimated: a doubly linked list over the input vertex ids.
+struct WorkLayer {
+    bool closed = false;
+    std::vector<Vec2> original, pos;
+    std::vector<std::size_t> prev, next;
+    std::vector<char> alive, locked;
+    std::size_t alive_count = 0, target = 0;
+    std::size_t first() const {  // an alive vertex to start walking from
+        for (std::size_t i = 0; i < alive.size(); ++i)
+            if (alive[i]) return i;
+        return kNone;
+    }
+};
+
+struct Candidate {
+    double cost;
+    std::uint32_t layer, vertex, version;
+    bool operator>(const Candidate& o) const {
+        if (cost != o.cost) return cost > o.cost;
+        if (layer != o.layer) return layer > o.layer;
+        return vertex > o.vertex;
+    }
+};
+
+bool point_in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
+    const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+}
+
+double segment_distance(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
+    return std::min(
+        std::min(point_segment_distance(p0, q0, q1), point_segment_distance(p1, q0, q1)),
+        std::min(point_segment_distance(q0, p0, p1), point_segment_distance(q1, p0, p1)));
+}
+
+class Driver {
+  public:
+    Driver(const Scene& scene, const SimplifyParams& params)
+        : input_(scene),
+          params_(params),
+          decimator_(make_decimator(params.decimator, params.seed)),
+          grid_(1.0) {
+        const std::size_t n = scene.size();
+        layers_.resize(n);
+        std::vector<double> lengths;
+        for (std::size_t l = 0; l < n; ++l) {
+            const Layer& in = scene.layer(l);
+            WorkLayer& w = layers_[l];
+            const std::size_t m = in.points.size();
+            w.closed = in.closed;
+            w.original = w.pos = in.points;
+            w.prev.resize(m);
+            w.next.resize(m);
+            for (std::size_t i = 0; i < m; ++i) {
+                w.prev[i] = i > 0 ? i - 1 : (in.closed ? m - 1 : kNone);
+                w.next[i] = i + 1 < m ? i + 1 : (in.closed ? 0 : kNone);
+            }
+            w.alive.assign(m, 1);
+            w.locked.assign(m, 0);
+            w.alive_count = m;
+            const std::size_t floor_count = in.closed ? 3 : 2;
+            std::size_t target = params.keep > 0 ? params.keep
+                                                 : m - static_cast<std::size_t>(std::floor(
+                                                           params.remove * static_cast<double>(m)));
+            w.target = std::max(std::min(target, m), floor_count);
+            for (std::size_t i = 0; i < in.segment_count(); ++i)
+                lengths.push_back(glm::distance(in.segment_start(i), in.segment_end(i)));
+        }
+        std::nth_element(lengths.begin(),
+                         lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2),
+                         lengths.end());
+        const double median = lengths.empty() ? 1.0 : lengths[lengths.size() / 2];
+        grid_ = SegmentGrid(std::max(4.0 * median, std::numeric_limits<double>::min()));
+        for (std::size_t l = 0; l < n; ++l)
+            for (std::size_t i = 0; i < layers_[l].alive.size(); ++i)
+                if (has_segment(l, i)) grid_.insert(ref(l, i), seg_box(l, i));
+
+        // Separation each layer needs from every other, with the tolerance applied.
+        need_.assign(n, std::vector<double>(n, 0.0));
+        reach_.assign(n, 0.0);
+        nest_thickness_.assign(n, 0.0);
+        for (std::size_t a = 0; a < n; ++a)
+            for (std::size_t b = 0; b < n; ++b) {
+                if (a == b) continue;
+                need_[a][b] = scene.required_separation(a, b) *
+                              (1.0 - params.untangling.separation_tolerance);
+                reach_[a] = std::max(reach_[a], need_[a][b]);
+                if (scene.relation(a, b) != Relation::SideBySide)
+                    nest_thickness_[a] += scene.layer(b).thickness;
+            }
+        for (std::size_t a = 0; a < n; ++a) nest_thickness_[a] += scene.layer(a).thickness;
+        stamp_.resize(n);
+        for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
+        version_.resize(n);
+        for (std::size_t l = 0; l < n; ++l) version_[l].assign(layers_[l].alive.size(), 0);
+        if (params.untangle) settings_ = detail::resolve_settings(scene, params.untangling);
+        report_.layers.resize(n);
+    }
+
+    SimplifyReport run(const ProgressFn& progress) {
+        const auto start_all = Clock::now();
+        std::size_t to_remove = 0;
+        for (const WorkLayer& w : layers_) to_remove += w.alive_count - w.target;
+        for (std::size_t l = 0; l < layers_.size(); ++l)
+            for (std::size_t v = 0; v < layers_[l].alive.size(); ++v) push(l, v);
+        std::size_t done = 0, last_reported = 0;
+        while (!queue_.empty()) {
+            const Candidate c = queue_.top();
+            queue_.pop();
+            const std::size_t l = c.layer, v = c.vertex;
+            WorkLayer& w = layers_[l];
+            if (c.version != version_[l][v] || !removable(l, v) || w.alive_count <= w.target)
+                continue;
+            const std::size_t a = w.prev[v], b = w.next[v];
+            if (params_.max_error > 0.0 && span_error(view(l), a, b) > params_.max_error) {
+                w.locked[v] = 1;
+                continue;
+            }
+            if (try_remove(l, v)) {
+                ++report_.removed;
+                ++done;
+            } else {
+                w.locked[v] = 1;
+                ++report_.refused;
+                ++report_.layers[l].refused;
+            }
+            if (progress && (done - last_reported) * 100 >= to_remove) {
+                last_reported = done;
+                if (!progress("simplify",
+                              to_remove ? static_cast<double>(done) / static_cast<double>(to_remove)
+                                        : 1.0))
+                    throw Cancelled();
+            }
+        }
+        if (progress && !progress("simplify", 1.0)) throw Cancelled();
+        report_.seconds_total = seconds_since(start_all);
+        return report_;
+    }
+
+    Scene result() const {
+        std::vector<Layer> layers = input_.layers();
+        for (std::size_t l = 0; l < layers.size(); ++l) {
+            const WorkLayer& w = layers_[l];
+            std::vector<Vec2> points;
+            const std::size_t start = w.first();
+            std::size_t i = start;
+            do {
+                points.push_back(w.pos[i]);
+                i = w.next[i];
+            } while (i != kNone && i != start);
+            layers[l].points = std::move(points);
+        }
+        Scene out(std::move(layers), input_.units());
+        out.metadata = input_.metadata;
+        return out;
+    }
+
+    SimplifyReport& report() { return report_; }
+    std::size_t target(std::size_t l) const { return layers_[l].target; }
+
+  private:
+    static SegRef ref(std::size_t l, std::size_t i) {
+        return {static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)};
+    }
+    bool has_segment(std::size_t l, std::size_t i) const {
+        return layers_[l].alive[i] && layers_[l].next[i] != kNone;
+    }
+    Box2 seg_box(std::size_t l, std::size_t i) const {
+        Box2 box;
+        box.extend(layers_[l].pos[i]);
+        box.extend(layers_[l].pos[layers_[l].next[i]]);
+        return box;
+    }
+    DecimationView view(std::size_t l) const {
+        return DecimationView{layers_[l].original, layers_[l].pos, layers_[l].closed};
+    }
+    bool removable(std::size_t l, std::size_t v) const {
+        const WorkLayer& w = layers_[l];
+        if (!w.alive[v] || w.locked[v]) return false;
+        if (!w.closed && (w.prev[v] == kNone || w.next[v] == kNone)) return false;  // ends stay
+        return w.alive_count > (w.closed ? 3 : 2);
+    }
+    void push(std::size_t l, std::size_t v) {
+        if (!removable(l, v)) return;
+        const WorkLayer& w = layers_[l];
+        const auto start = Clock::now();
+        const double cost = decimator_->cost(l, view(l), w.prev[v], v, w.next[v]);
+        report_.seconds_decimate += seconds_since(start);
+        queue_.push(
+            {cost, static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(v), ++version_[l][v]});
+    }
+
+    // Calls f(layer, start) once per segment whose box meets `box`.
+    template <class F>
+    void segments_near(const Box2& box, F&& f) {
+        ++stamp_counter_;
+        grid_.query(box, [&](SegRef s) {
+            std::uint32_t& mark = stamp_[s.layer][s.start];
+            if (mark == stamp_counter_) return;
+            mark = stamp_counter_;
+            f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+        });
+    }
+
+    // Segment (a, b) of layer l meets no other segment and keeps its separations.
+    bool segment_clear(std::size_t l, std::size_t a, std::size_t b) {
+        const WorkLayer& w = layers_[l];
+        const Vec2 p = w.pos[a], q = w.pos[b];
+        Box2 box;
+        box.extend(p);
+        box.extend(q);
+        bool ok = true;
+        segments_near(box.inflated(reach_[l]), [&](std::size_t k, std::size_t u) {
+            if (!ok) return;
+            const WorkLayer& o = layers_[k];
+            const std::size_t u2 = o.next[u];
+            if (k == l && (u == a || u == b || u2 == a || u2 == b)) return;
+            const Vec2 s0 = o.pos[u], s1 = o.pos[u2];
+            if (segment_contact(p, q, s0, s1) != SegmentContact::None) {
+                ok = false;
+                return;
+            }
+            if (k != l && need_[l][k] > 0.0 && segment_distance(p, q, s0, s1) < need_[l][k])
+                ok = false;
+        });
+        return ok;
+    }
+
+    // No vertex but a, b of any layer lies in the closed triangle (a, removed, b).
+    bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b) {
+        const WorkLayer& w = layers_[l];
+        const Vec2 pa = w.pos[a], pb = w.pos[b];
+        Box2 box;
+        box.extend(pa);
+        box.extend(pb);
+        box.extend(removed);
+        bool ok = true;
+        segments_near(box, [&](std::size_t k, std::size_t u) {
+            if (!ok) return;
+            const WorkLayer& o = layers_[k];
+            for (std::size_t x : {u, o.next[u]}) {
+                if (k == l && (x == a || x == b)) continue;
+                if (point_in_closed_triangle(pa, removed, pb, o.pos[x])) {
+                    ok = false;
+                    return;
+                }
+            }
+        });
+        return ok;
+    }
+
+    // Winding number of closed layer l around p (exact orientation tests).
+    int winding(std::size_t l, const Vec2& p) const {
+        const WorkLayer& w = layers_[l];
+        int wn = 0;
+        const std::size_t start = w.first();
+        std::size_t i = start;
+        do {
+            const std::size_t j = w.next[i];
+            const Vec2 a = w.pos[i], b = w.pos[j];
+            if (a.y <= p.y) {
+                if (b.y > p.y && orient2d(a, b, p) > 0) ++wn;
+            } else if (b.y <= p.y && orient2d(a, b, p) < 0) {
+                --wn;
+            }
+            i = j;
+        } while (i != start);
+        return wn;
+    }
+
+    // Every vertex of `ids` (layer l) is inside the closed layers it is under and outside the
+    // closed layers it is over or beside: moving vertices can carry a whole small loop out of
+    // another without any crossing left at the end.
+    bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids) const {
+        for (std::size_t k = 0; k < layers_.size(); ++k) {
+            if (k == l || !layers_[k].closed) continue;
+            const Relation rel = input_.relation(l, k);
+            for (std::size_t id : ids) {
+                const bool inside = winding(k, layers_[l].pos[id]) != 0;
+                if (inside != (rel == Relation::Under)) return false;
+            }
+        }
+        return true;
+    }
+
+    bool closed_valid(std::size_t l) const {
+        const WorkLayer& w = layers_[l];
+        if (!w.closed || w.alive_count > 3) return true;
+        const std::size_t i = w.first(), j = w.next[i], k = w.next[j];
+        return orient2d(w.pos[i], w.pos[j], w.pos[k]) != 0;
+    }
+
+    void unlink(std::size_t l, std::size_t v) {
+        WorkLayer& w = layers_[l];
+        const std::size_t a = w.prev[v], b = w.next[v];
+        grid_.erase(ref(l, a), seg_box(l, a));
+        grid_.erase(ref(l, v), seg_box(l, v));
+        w.alive[v] = 0;
+        w.next[a] = b;
+        w.prev[b] = a;
+        --w.alive_count;
+        grid_.insert(ref(l, a), seg_box(l, a));
+    }
+
+    void relink(std::size_t l, std::size_t v) {
+        WorkLayer& w = layers_[l];
+        const std::size_t a = w.prev[v], b = w.next[v];
+        grid_.erase(ref(l, a), seg_box(l, a));
+        w.alive[v] = 1;
+        w.next[a] = v;
+        w.prev[b] = v;
+        ++w.alive_count;
+        grid_.insert(ref(l, a), seg_box(l, a));
+        grid_.insert(ref(l, v), seg_box(l, v));
+    }
+
+    // Moves vertex v of layer l, keeping the grid in step.
+    void move(std::size_t l, std::size_t v, const Vec2& to) {
+        WorkLayer& w = layers_[l];
+        if (w.pos[v] == to) return;
+        const std::size_t a = w.prev[v];
+        if (a != kNone) grid_.erase(ref(l, a), seg_box(l, a));
+        if (w.next[v] != kNone) grid_.erase(ref(l, v), seg_box(l, v));
+        w.pos[v] = to;
+        if (a != kNone) grid_.insert(ref(l, a), seg_box(l, a));
+        if (w.next[v] != kNone) grid_.insert(ref(l, v), seg_box(l, v));
+    }
+
+    bool try_remove(std::size_t l, std::size_t v) {
+        WorkLayer& w = layers_[l];
+        const std::size_t a = w.prev[v], b = w.next[v];
+        const Vec2 removed = w.pos[v];
+        auto start = Clock::now();
+        unlink(l, v);
+        const bool clear =
+            !params_.untangle ||
+            (closed_valid(l) && triangle_empty(l, a, removed, b) && segment_clear(l, a, b));
+        report_.seconds_check += seconds_since(start);
+        if (clear) {
+            push(l, a);
+            push(l, b);
+            return true;
+        }
+        if (untangle_around(l, a, removed, b)) return true;
+        relink(l, v);
+        return false;
+    }
+
+    // A run of alive vertices of one layer, in order, standing for one work layer.
+    struct Run {
+        std::size_t layer = 0;
+        std::vector<std::size_t> ids;
+        bool whole_loop = false;
+    };
+
+    // Runs of layer k through its marked vertices, extended by n_out on both sides.
+    void runs_of(std::size_t k, std::vector<char>& mark, std::vector<Run>& out) const {
+        const WorkLayer& w = layers_[k];
+        // Extend the marks by the collars.
+        std::vector<std::size_t> seeds;
+        for (std::size_t i = 0; i < mark.size(); ++i)
+            if (mark[i]) seeds.push_back(i);
+        for (std::size_t s : seeds) {
+            std::size_t i = s, j = s;
+            for (std::size_t c = 0; c < params_.n_out; ++c) {
+                if (w.prev[i] != kNone) i = w.prev[i];
+                if (w.next[j] != kNone) j = w.next[j];
+                mark[i] = mark[j] = 1;
+            }
+        }
+        std::size_t start = w.first();
+        if (w.closed) {
+            std::size_t i = start, steps = 0;
+            while (mark[i] && steps <= w.alive_count) {
+                i = w.next[i];
+                ++steps;
+            }
+            if (steps > w.alive_count) {  // every vertex marked: the whole loop
+                Run run{k, {}, true};
+                std::size_t x = start;
+                do {
+                    run.ids.push_back(x);
+                    x = w.next[x];
+                } while (x != start);
+                out.push_back(std::move(run));
+                return;
+            }
+            start = i;  // an unmarked vertex: runs do not wrap past it
+        }
+        Run run{k, {}, false};
+        std::size_t i = start;
+        do {
+            if (mark[i]) {
+                run.ids.push_back(i);
+            } else if (!run.ids.empty()) {
+                out.push_back(std::move(run));
+                run = Run{k, {}, false};
+            }
+            i = w.next[i];
+        } while (i != kNone && i != start);
+        if (!run.ids.empty()) out.push_back(std::move(run));
+    }
+
+    bool untangle_around(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b) {
+        WorkLayer& w = layers_[l];
+        ++report_.untangle_calls;
+        ++report_.layers[l].untangled;
+        auto start = Clock::now();
+        Box2 box;
+        box.extend(w.pos[a]);
+        box.extend(w.pos[b]);
+        box.extend(removed);
+        const double chord = glm::distance(w.pos[a], w.pos[b]);
+        const Box2 region = box.inflated(std::max(2.0 * nest_thickness_[l], 0.5 * chord));
+        const Box2 around = region.inflated(std::max(2.0 * nest_thickness_[l], chord));
+        // Work layers: runs through the vertices of the segments near the region.
+        std::vector<std::vector<char>> marks(layers_.size());
+        if (params_.global) {
+            for (std::size_t k = 0; k < layers_.size(); ++k) marks[k] = layers_[k].alive;
+        } else {
+            for (std::size_t k = 0; k < layers_.size(); ++k)
+                marks[k].assign(layers_[k].alive.size(), 0);
+            segments_near(around, [&](std::size_t k, std::size_t u) {
+                marks[k][u] = 1;
+                marks[k][layers_[k].next[u]] = 1;
+            });
+        }
+        std::vector<Run> runs;
+        for (std::size_t k = 0; k < layers_.size(); ++k)
+            if (std::find(marks[k].begin(), marks[k].end(), 1) != marks[k].end())
+                runs_of(k, marks[k], runs);
+
+        std::vector<Layer> work_layers;
+        std::vector<Piece> pieces;
+        detail::RelationSource relations;
+        relations.scene = &input_;
+        detail::EngineSettings settings = settings_;
+        settings.outside_signs.clear();
+        for (std::size_t r = 0; r < runs.size(); ++r) {
+            const Run& run = runs[r];
+            const Layer& parent = input_.layer(run.layer);
+            Layer layer;
+            layer.name = parent.name + "#" + std::to_string(r);
+            layer.closed = run.whole_loop;
+            layer.thickness = parent.thickness;
+            layer.weight = parent.weight;
+            layer.alpha = parent.alpha;
+            layer.beta = parent.beta;
+            Piece piece;
+            piece.layer = r;
+            piece.is_whole_loop = run.whole_loop;
+            for (std::size_t id : run.ids) {
+                const Vec2 p = layers_[run.layer].pos[id];
+                if (!layer.points.empty() && layer.points.back() == p)
+                    return false;  // would be merged
+                layer.points.push_back(p);
+                piece.vertices.push_back(piece.vertices.size());
+                // Open layers keep their end vertices where they are.
+                const WorkLayer& parent_work = layers_[run.layer];
+                const bool is_end = !parent_work.closed && (parent_work.prev[id] == kNone ||
+                                                            parent_work.next[id] == kNone);
+                piece.is_free.push_back(!is_end && (params_.global || region.contains(p)) ? 1 : 0);
+            }
+            if (layer.closed && layer.points.front() == layer.points.back()) return false;
+            work_layers.push_back(std::move(layer));
+            pieces.push_back(std::move(piece));
+            relations.parent.push_back(run.layer);
+            settings.outside_signs.push_back(settings_.outside_signs[run.layer]);
+        }
+        Scene work(std::move(work_layers));
+        // Positions to restore on failure.
+        std::vector<Vec2> saved;
+        for (const Run& run : runs)
+            for (std::size_t id : run.ids) saved.push_back(layers_[run.layer].pos[id]);
+        report_.seconds_check += seconds_since(start);
+
+        auto apply = [&](const Scene& s) {
+            for (std::size_t r = 0; r < runs.size(); ++r)
+                for (std::size_t k = 0; k < runs[r].ids.size(); ++k)
+                    if (pieces[r].is_free[k])
+                        move(runs[r].layer, runs[r].ids[k], s.layer(r).points[k]);
+        };
+        auto is_ok = [&](const Scene& s) {
+            apply(s);
+            if (!closed_valid(l) || !triangle_empty(l, a, removed, b) || !segment_clear(l, a, b))
+                return false;
+            for (std::size_t r = 0; r < runs.size(); ++r) {
+                const WorkLayer& o = layers_[runs[r].layer];
+                for (std::size_t k = 0; k < runs[r].ids.size(); ++k) {
+                    if (!pieces[r].is_free[k]) continue;
+                    const std::size_t id = runs[r].ids[k];
+                    if (o.prev[id] != kNone && !segment_clear(runs[r].layer, o.prev[id], id))
+                        return false;
+                    if (o.next[id] != kNone && !segment_clear(runs[r].layer, id, o.next[id]))
+                        return false;
+                }
+                if (!closed_valid(runs[r].layer)) return false;
+            }
+            // Nesting of the region's vertices against every closed layer near it.
+            for (const Run& run : runs)
+                if (!nesting_kept(run.layer, run.ids)) return false;
+            return true;
+        };
+        const detail::EngineResult result =
+            detail::run_engine(work, pieces, params_.untangling, relations, settings, is_ok, {});
+        report_.rounds += result.rounds;
+        report_.seconds_fields += result.seconds_fields;
+        report_.seconds_untangle += result.seconds_untangle;
+        report_.seconds_check += result.seconds_check;
+        if (result.ok) {
+            push(l, a);
+            push(l, b);
+            for (std::size_t r = 0; r < runs.size(); ++r)
+                for (std::size_t k = 0; k < runs[r].ids.size(); ++k)
+                    if (pieces[r].is_free[k]) {
+                        const std::size_t id = runs[r].ids[k];
+                        push(runs[r].layer, id);
+                        const WorkLayer& o = layers_[runs[r].layer];
+                        if (o.prev[id] != kNone) push(runs[r].layer, o.prev[id]);
+                        if (o.next[id] != kNone) push(runs[r].layer, o.next[id]);
+                    }
+            return true;
+        }
+        std::size_t k = 0;
+        for (const Run& run : runs)
+            for (std::size_t id : run.ids) move(run.layer, id, saved[k++]);
+        return false;
+    }
+
+    const Scene& input_;
+    const SimplifyParams& params_;
+    std::unique_ptr<Decimator> decimator_;
+    std::vector<WorkLayer> layers_;
+    SegmentGrid grid_;
+    std::vector<std::vector<double>> need_;
+    std::vector<double> reach_, nest_thickness_;
+    std::vector<std::vector<std::uint32_t>> stamp_, version_;
+    std::uint32_t stamp_counter_ = 0;
+    std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
+    detail::EngineSettings settings_;
+    SimplifyReport report_;
+};
+
+}  // namespace
+
+void validate(const SimplifyParams& params) {
+    if (!(params.remove >= 0.0 && params.remove <= 1.0))
+        throw InvalidInput("simplify: params.remove must be in [0, 1] (got " +
+                           format_number(params.remove) + ")");
+    if (!(params.max_error >= 0.0) || !std::isfinite(params.max_error))
+        throw InvalidInput("simplify: params.max_error must be >= 0 and finite (got " +
+                           format_number(params.max_error) + ")");
+    make_decimator(params.decimator, params.seed);
+    validate(params.untangling);
+}
+
+SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const ProgressFn& progress) {
+    validate(params);
+    Driver driver(scene, params);
+    SimplifyReport report = driver.run(progress);
+    Scene out = driver.result();
+
+    auto start = Clock::now();
+    CheckParams check_params;
+    check_params.separation_tolerance = params.untangling.separation_tolerance;
+    const CheckReport check = check_scene(out, check_params);
+    report.crossings = check.crossing_count;
+    report.self_crossings = check.total_self_crossings();
+    report.nesting_violations = check.nesting_violation_count;
+    report.min_separation_ratio = check.min_separation_ratio;
+    report.collision_free = check.is_collision_free() && check.separations_hold();
+    const Vec2 size = scene.bounds().size();
+    const double tolerance = 1e-6 * std::max(std::hypot(size.x, size.y), 1e-300);
+    for (std::size_t l = 0; l < scene.size(); ++l) {
+        LayerSimplifyReport& r = report.layers[l];
+        const Layer& before = scene.layer(l);
+        const Layer& after = out.layer(l);
+        r.name = before.name;
+        r.before = before.points.size();
+        r.after = after.points.size();
+        r.target = driver.target(l);
+        if (r.after > r.target) report.targets_met = false;
+        r.hausdorff = hausdorff(after, before, tolerance).symmetric();
+    }
+    report.seconds_check += seconds_since(start);
+    scene = std::move(out);
+    return report;
+}
+
+}  // namespace strata

@@ -1,0 +1,228 @@
+#include "strata/core/error.h"
+#include "strata/geometry/checks.h"
+#include "strata/io/json_io.h"
+#include "strata/simplify/simplify.h"
+#include "support/fixtures.h"
+
+#include <tbb/global_control.h>
+#include <catch2/catch.hpp>
+#include <glm/geometric.hpp>
+
+#include <cmath>
+
+using namespace strata;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// `count` layers offset along the normal of a folded curve (like the demo), open or closed.
+Scene folded_stack(std::size_t count, std::size_t points, bool closed, double spacing = 0.04,
+                   double thickness = 0.01) {
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < count; ++k) {
+        Layer layer;
+        layer.name = "L" + std::to_string(k);
+        layer.closed = closed;
+        layer.thickness = thickness;
+        const double offset = spacing * static_cast<double>(k);
+        for (std::size_t i = 0; i < points; ++i) {
+            const double t =
+                static_cast<double>(i) / static_cast<double>(closed ? points : points - 1);
+            if (closed) {  // a wobbly loop, offset outward (curvature radius > the offsets)
+                const double a = 2.0 * kPi * t;
+                const double r = 1.0 + 0.06 * std::sin(5.0 * a) + 0.015 * std::sin(11.0 * a);
+                const double dr = 0.3 * std::cos(5.0 * a) + 0.165 * std::cos(11.0 * a);
+                const Vec2 p(r * std::cos(a), r * std::sin(a));
+                const Vec2 tangent(dr * std::cos(a) - r * std::sin(a),
+                                   dr * std::sin(a) + r * std::cos(a));
+                const Vec2 normal = glm::normalize(Vec2(tangent.y, -tangent.x));
+                layer.points.push_back(p + offset * normal);
+            } else {
+                const double x = 10.0 * t;
+                const double y = 0.5 * std::sin(0.6 * x) + 0.18 * std::sin(2.3 * x + 0.5) +
+                                 0.07 * std::sin(6.1 * x);
+                const double d = 0.3 * std::cos(0.6 * x) + 0.414 * std::cos(2.3 * x + 0.5) +
+                                 0.427 * std::cos(6.1 * x);
+                const double len = std::sqrt(1.0 + d * d);
+                layer.points.emplace_back(x - offset * d / len, y + offset / len);
+            }
+        }
+        layers.push_back(std::move(layer));
+    }
+    return Scene(std::move(layers));
+}
+
+// The invariants of a collision-free simplification, checked exactly.
+void require_valid(const Scene& input, const Scene& out, const SimplifyReport& r, double tol) {
+    CheckParams params;
+    params.separation_tolerance = tol;
+    const CheckReport check = check_scene(out, params);
+    CHECK(check.crossing_count == 0);
+    CHECK(check.total_self_crossings() == 0);
+    CHECK(check.nesting_violation_count == 0);
+    CHECK(check.separation_violation_count == 0);
+    CHECK(r.collision_free);
+    CHECK(r.crossings == 0);
+    for (std::size_t l = 0; l < out.size(); ++l) {
+        const LayerSimplifyReport& lr = r.layers[l];
+        CHECK(lr.after == out.layer(l).points.size());
+        // The target is met, or the shortfall is reported as refused removals.
+        if (lr.after > lr.target) {
+            CHECK(lr.refused > 0);
+            CHECK_FALSE(r.targets_met);
+        }
+        if (!input.layer(l).closed) {  // open layers keep their ends
+            CHECK(out.layer(l).points.front() == input.layer(l).points.front());
+            CHECK(out.layer(l).points.back() == input.layer(l).points.back());
+        }
+    }
+}
+
+}  // namespace
+
+TEST_CASE("generated stacks simplify without collisions, naive decimation collides (slow)",
+          "[simplify][slow]") {
+    for (const bool closed : {false, true}) {
+        for (const std::size_t count : {std::size_t(5), std::size_t(8)}) {
+            const Scene input =
+                folded_stack(count, closed ? 240 : 200, closed, closed ? 0.025 : 0.04);
+            REQUIRE(check_scene(input).is_collision_free());
+            for (const char* decimator : {"random", "visvalingam", "max-error"}) {
+                for (const double remove : {0.8, 0.9, 0.95}) {
+                    INFO((closed ? "closed " : "open ")
+                         << count << " layers, " << decimator << ", remove " << remove);
+                    SimplifyParams params;
+                    params.decimator = decimator;
+                    params.remove = remove;
+                    params.seed = 3;
+                    Scene out = input;
+                    const SimplifyReport r = simplify(out, params);
+                    require_valid(input, out, r, params.untangling.separation_tolerance);
+                    if (std::string(decimator) == "random") {
+                        SimplifyParams naive = params;
+                        naive.untangle = false;
+                        Scene bad = input;
+                        const SimplifyReport n = simplify(bad, naive);
+                        CHECK(n.crossings + n.nesting_violations > 0);  // the test has teeth
+                    }
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("several seeds of random decimation", "[simplify]") {
+    const Scene input = folded_stack(5, 300, false);
+    for (std::uint64_t seed : {1u, 2u, 5u}) {
+        INFO("seed " << seed);
+        SimplifyParams params;
+        params.decimator = "random";
+        params.seed = seed;
+        Scene out = input;
+        const SimplifyReport r = simplify(out, params);
+        require_valid(input, out, r, params.untangling.separation_tolerance);
+    }
+}
+
+TEST_CASE("the result is the same at 1 and 2 threads", "[simplify]") {
+    const Scene input = folded_stack(5, 300, false);
+    for (FieldBackend backend : {FieldBackend::Grid, FieldBackend::ExactIndexed}) {
+        SimplifyParams params;
+        params.decimator = "random";
+        params.untangling.field.backend = backend;
+        Scene one = input, two = input;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            simplify(one, params);
+        }
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+            simplify(two, params);
+        }
+        for (std::size_t l = 0; l < one.size(); ++l)
+            CHECK(one.layer(l).points == two.layer(l).points);
+    }
+}
+
+TEST_CASE("every real slice simplifies without collisions (slow)", "[simplify][slices][slow]") {
+    for (const char* name : {"cipc_multilayer_y+0.00.json", "cipc_multilayer_y-0.15.json",
+                             "cipc_multilayer_y-0.30.json", "mh_casualsuit03_y+1.50.json",
+                             "mh_casualsuit03_y+4.00.json", "mh_casualsuit05_y+4.00.json",
+                             "mh_elegantsuit01_y+0.50.json", "mh_elegantsuit01_y+1.50.json"}) {
+        const Scene input = read_scene_json(test::test_data(std::string("slices/") + name));
+        for (const char* decimator : {"random", "visvalingam", "max-error"}) {
+            for (const double remove : {0.8, 0.9, 0.95}) {
+                INFO(name << ", " << decimator << ", remove " << remove);
+                SimplifyParams params;
+                params.decimator = decimator;
+                params.remove = remove;
+                Scene out = input;
+                const SimplifyReport r = simplify(out, params);
+                require_valid(input, out, r, params.untangling.separation_tolerance);
+            }
+        }
+    }
+}
+
+TEST_CASE("shape matching keeps the vertices of a layer apart", "[simplify]") {
+    // Paper, Fig. 2: without shape matching the projected vertices bunch up.
+    const Scene input = folded_stack(5, 300, false);
+    std::vector<double> lengths;
+    for (const Layer& layer : input.layers())
+        for (std::size_t i = 0; i + 1 < layer.points.size(); ++i)
+            lengths.push_back(glm::distance(layer.points[i], layer.points[i + 1]));
+    std::sort(lengths.begin(), lengths.end());
+    const double median = lengths[lengths.size() / 2];
+    SimplifyParams params;
+    params.decimator = "random";
+    Scene out = input;
+    simplify(out, params);
+    double closest = std::numeric_limits<double>::infinity();
+    for (const Layer& layer : out.layers())
+        for (std::size_t i = 0; i + 1 < layer.points.size(); ++i)
+            closest = std::min(closest, glm::distance(layer.points[i], layer.points[i + 1]));
+    // Stated fraction: consecutive vertices stay at least half an input segment apart
+    // (the output's segments are about ten input segments long).
+    CHECK(closest > 0.5 * median);
+}
+
+TEST_CASE("max-error bounds the naive decimation's Hausdorff distance", "[simplify]") {
+    const Scene input = folded_stack(3, 300, false);
+    SimplifyParams params;
+    params.decimator = "max-error";
+    params.remove = 1.0;
+    params.max_error = 0.01;
+    params.untangle = false;
+    Scene out = input;
+    const SimplifyReport r = simplify(out, params);
+    for (const LayerSimplifyReport& l : r.layers) {
+        CHECK(l.hausdorff <= 0.01 * (1.0 + 1e-9));
+        CHECK(l.after < l.before / 4);
+    }
+}
+
+TEST_CASE("the demo scene is valid and naive decimation tangles it", "[simplify]") {
+    const Scene demo = demo_scene();
+    REQUIRE(demo.size() == 5);
+    REQUIRE(check_scene(demo).is_collision_free());
+    SimplifyParams params;
+    params.decimator = "random";
+    params.untangle = false;
+    Scene bad = demo;
+    CHECK(simplify(bad, params).crossings > 0);
+}
+
+TEST_CASE("bad simplify parameters are rejected by name", "[simplify]") {
+    Scene scene = test::stacked_sines(2, 50);
+    SimplifyParams params;
+    params.remove = 1.5;
+    CHECK_THROWS_WITH(simplify(scene, params),
+                      Catch::Contains("params.remove") && Catch::Contains("1.5"));
+    params = {};
+    params.decimator = "nope";
+    CHECK_THROWS_WITH(simplify(scene, params), Catch::Contains("'nope'"));
+    params = {};
+    params.untangling.alpha = -1.0;
+    CHECK_THROWS_WITH(simplify(scene, params), Catch::Contains("params.alpha"));
+}
