@@ -1,0 +1,67 @@
+#include "cli_util.h"
+
+#include "strata/core/error.h"
+#include "strata/io/atomic_file.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+
+namespace strata::cli {
+
+ProgressFn terminal_progress() {
+    if (!isatty(fileno(stderr))) return {};
+    auto last = std::make_shared<std::chrono::steady_clock::time_point>();
+    return [last](std::string_view stage, double fraction) {
+        const auto now = std::chrono::steady_clock::now();
+        if (fraction < 1.0 && now - *last < std::chrono::milliseconds(100)) return true;
+        *last = now;
+        const int width = 30;
+        const int filled = static_cast<int>(fraction * width + 0.5);
+        std::fprintf(stderr, "\r%-12.*s [%.*s%*s] %3d%%", static_cast<int>(stage.size()),
+                     stage.data(), filled, "##############################", width - filled, "",
+                     static_cast<int>(fraction * 100.0 + 0.5));
+        if (fraction >= 1.0) std::fputc('\n', stderr);
+        std::fflush(stderr);
+        return true;
+    };
+}
+
+void check_outputs(const std::vector<std::string>& outputs,
+                   const std::vector<std::string>& inputs) {
+    std::vector<std::filesystem::path> in(inputs.begin(), inputs.end());
+    for (const std::string& out : outputs) {
+        if (out.empty()) continue;
+        ensure_not_an_input(out, in);
+        const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+        if (!parent.empty() && !std::filesystem::is_directory(parent))
+            throw InvalidInput(out + ": folder '" + parent.string() + "' does not exist");
+    }
+}
+
+void add_backend_option(CLI::App& cmd, FieldBackend& backend) {
+    static const std::map<std::string, FieldBackend> names{{"grid", FieldBackend::Grid},
+                                                           {"exact", FieldBackend::ExactBrute},
+                                                           {"indexed", FieldBackend::ExactIndexed}};
+    cmd.add_option("--backend", backend,
+                   "Field backend: grid (OpenVDB narrow band), exact (brute force) or indexed "
+                   "(exact, bucketed)")
+        ->transform(CLI::CheckedTransformer(names, CLI::ignore_case))
+        ->default_str(backend_name(backend));
+}
+
+const char* backend_name(FieldBackend backend) {
+    switch (backend) {
+        case FieldBackend::Grid:
+            return "grid";
+        case FieldBackend::ExactBrute:
+            return "exact";
+        case FieldBackend::ExactIndexed:
+            return "indexed";
+    }
+    return "?";
+}
+
+}  // namespace strata::cli

@@ -1,0 +1,345 @@
+// strata simplify: collision-free simplification of one scene, a demo, or a batch of slices.
+#include "cli_util.h"
+#include "commands.h"
+
+#include "strata/core/error.h"
+#include "strata/geometry/checks.h"
+#include "strata/io/atomic_file.h"
+#include "strata/io/scene_io.h"
+#include "strata/io/svg_io.h"
+#include "strata/simplify/simplify.h"
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+namespace strata::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SimplifyOptions {
+    std::vector<std::string> inputs;
+    std::string output, svg, report;
+    double thickness = 0.0;
+    int threads = 0;
+    bool no_shape_matching = false;
+    bool naive = false;
+    SimplifyParams params;
+};
+
+Scene with_default_thickness(const Scene& scene, double thickness) {
+    if (thickness <= 0.0) return scene;
+    std::vector<Layer> layers = scene.layers();
+    for (Layer& layer : layers)
+        if (layer.thickness == 0.0) layer.thickness = thickness;
+    Scene out(std::move(layers), scene.units());
+    out.metadata = scene.metadata;
+    return out;
+}
+
+nlohmann::json finite_or_null(double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive) {
+    nlohmann::json layers = nlohmann::json::array();
+    for (const LayerSimplifyReport& l : r.layers)
+        layers.push_back({{"name", l.name},
+                          {"before", l.before},
+                          {"after", l.after},
+                          {"target", l.target},
+                          {"refused", l.refused},
+                          {"untangled", l.untangled},
+                          {"hausdorff", l.hausdorff}});
+    nlohmann::json j = {{"layers", layers},
+                        {"removed", r.removed},
+                        {"untangle_calls", r.untangle_calls},
+                        {"refused", r.refused},
+                        {"rounds", r.rounds},
+                        {"targets_met", r.targets_met},
+                        {"crossings", r.crossings},
+                        {"self_crossings", r.self_crossings},
+                        {"nesting_violations", r.nesting_violations},
+                        {"min_separation_ratio", finite_or_null(r.min_separation_ratio)},
+                        {"collision_free", r.collision_free},
+                        {"seconds",
+                         {{"decimate", r.seconds_decimate},
+                          {"fields", r.seconds_fields},
+                          {"untangle", r.seconds_untangle},
+                          {"check", r.seconds_check},
+                          {"total", r.seconds_total}}}};
+    if (naive)
+        j["naive"] = {{"crossings", naive->crossings},
+                      {"self_crossings", naive->self_crossings},
+                      {"nesting_violations", naive->nesting_violations},
+                      {"min_separation_ratio", finite_or_null(naive->min_separation_ratio)}};
+    return j;
+}
+
+double max_hausdorff(const SimplifyReport& r) {
+    double h = 0.0;
+    for (const LayerSimplifyReport& l : r.layers) h = std::max(h, l.hausdorff);
+    return h;
+}
+
+void print_summary(const std::string& name, const SimplifyReport& r, const SimplifyReport* naive) {
+    std::printf("%-22s %8s %8s %8s %8s %9s %12s\n", "layer", "before", "after", "target", "refused",
+                "untangled", "hausdorff");
+    for (const LayerSimplifyReport& l : r.layers)
+        std::printf("%-22s %8zu %8zu %8zu %8zu %9zu %12.4g\n", l.name.c_str(), l.before, l.after,
+                    l.target, l.refused, l.untangled, l.hausdorff);
+    std::size_t before = 0, after = 0;
+    for (const LayerSimplifyReport& l : r.layers) {
+        before += l.before;
+        after += l.after;
+    }
+    std::printf(
+        "%s: vertices %zu -> %zu; crossings naive %s, strata %zu; nesting violations naive %s, "
+        "strata %zu\n",
+        name.c_str(), before, after, naive ? std::to_string(naive->crossings).c_str() : "-",
+        r.crossings, naive ? std::to_string(naive->nesting_violations).c_str() : "-",
+        r.nesting_violations);
+    std::printf(
+        "min separation ratio %.4g; max Hausdorff %.4g; removals %zu, untangled %zu, refused %zu; "
+        "time %.3f s (decimate %.3f, fields %.3f, untangle %.3f, check %.3f)\n",
+        r.min_separation_ratio, max_hausdorff(r), r.removed, r.untangle_calls, r.refused,
+        r.seconds_total, r.seconds_decimate, r.seconds_fields, r.seconds_untangle, r.seconds_check);
+    if (!r.collision_free)
+        std::fprintf(
+            stderr,
+            "strata: warning: %s: the result is NOT collision-free (%zu crossings, %zu nesting "
+            "violations)\n",
+            name.c_str(), r.crossings, r.nesting_violations);
+    if (!r.targets_met)
+        std::fprintf(
+            stderr,
+            "strata: warning: %s: %zu removals refused; some layers stay above their target "
+            "(see the table)\n",
+            name.c_str(), r.refused);
+}
+
+struct Outcome {
+    std::string input, output;
+    std::optional<SimplifyReport> report, naive;
+    std::string error;
+};
+
+// Simplifies one scene; the naive run (no untangling) is made beside it for the numbers.
+Outcome run_one(const Scene& input, const SimplifyOptions& opt, const ProgressFn& progress,
+                Scene& result, Scene* naive_result) {
+    Outcome out;
+    SimplifyParams naive_params = opt.params;
+    naive_params.untangle = false;
+    Scene naive = input;
+    out.naive = simplify(naive, naive_params);
+    if (naive_result) *naive_result = naive;
+    if (opt.naive) {
+        result = naive;
+        out.report = out.naive;
+        return out;
+    }
+    result = input;
+    out.report = simplify(result, opt.params, progress);
+    return out;
+}
+
+int run_demo(const SimplifyOptions& opt) {
+    const fs::path dir = opt.output.empty() ? fs::path("strata-demo") : fs::path(opt.output);
+    fs::create_directories(dir);
+    const Scene input = demo_scene();
+    Scene result, naive;
+    const Outcome o = run_one(input, opt, terminal_progress(), result, &naive);
+    write_scene(input, dir / "input.json");
+    write_scene(naive, dir / "naive.json");
+    write_scene(result, dir / "strata.json");
+    SvgWriteParams svg;
+    svg.width_px = 1000.0;
+    write_file_atomic(
+        dir / "compare.svg",
+        panels_to_svg(
+            {{"input (" + std::to_string(input.vertex_count()) + " vertices)", &input, nullptr},
+             {"naive decimation: layers cross", &naive, &input},
+             {"strata: collision-free", &result, &input}},
+            svg));
+    write_file_atomic(dir / "report.json", report_json(*o.report, &*o.naive).dump(2) + "\n");
+    std::printf(
+        "demo: 5 stacked cloth-like layers, %zu vertices; outputs in %s/ (input.json, naive.json, "
+        "strata.json, compare.svg, report.json)\n",
+        input.vertex_count(), dir.string().c_str());
+    print_summary("demo", *o.report, &*o.naive);
+    return o.report->collision_free ? 0 : 1;
+}
+
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+    std::vector<std::string> files;
+    for (const std::string& in : inputs) {
+        if (fs::is_directory(in)) {
+            std::vector<std::string> found;
+            for (const auto& entry : fs::directory_iterator(in))
+                if (entry.is_regular_file() &&
+                    (entry.path().extension() == ".json" || entry.path().extension() == ".svg"))
+                    found.push_back(entry.path().string());
+            std::sort(found.begin(), found.end());
+            files.insert(files.end(), found.begin(), found.end());
+        } else {
+            files.push_back(in);
+        }
+    }
+    return files;
+}
+
+int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files) {
+    if (opt.output.empty()) throw InvalidInput("simplify: several inputs need -o FOLDER");
+    if (!fs::is_directory(opt.output)) fs::create_directories(opt.output);
+    std::vector<Outcome> outcomes(files.size());
+    tbb::parallel_for(std::size_t(0), files.size(), [&](std::size_t i) {
+        Outcome& o = outcomes[i];
+        o.input = files[i];
+        o.output = (fs::path(opt.output) / (fs::path(files[i]).stem().string() + ".json")).string();
+        try {
+            ensure_not_an_input(o.output, {fs::path(files[i])});
+            const Scene input = with_default_thickness(read_scene(files[i]), opt.thickness);
+            const CheckReport before = check_scene(input);
+            if (!before.is_collision_free())
+                throw InvalidInput("input already crosses (" +
+                                   std::to_string(before.crossing_count) + " crossings, " +
+                                   std::to_string(before.nesting_violation_count) +
+                                   " nesting violations); not simplified");
+            Scene result;
+            Outcome r = run_one(input, opt, {}, result, nullptr);
+            write_scene(result, o.output);
+            o.report = std::move(r.report);
+            o.naive = std::move(r.naive);
+        } catch (const std::exception& e) {
+            o.error = e.what();
+        }
+    });
+    std::printf("%-40s %8s %8s %7s %7s %8s %9s %8s\n", "slice", "before", "after", "naive-x",
+                "strata-x", "refused", "hausdorff", "time-s");
+    std::size_t failed = 0, tangled = 0;
+    nlohmann::json all = nlohmann::json::array();
+    for (const Outcome& o : outcomes) {
+        const std::string name = fs::path(o.input).filename().string();
+        if (!o.error.empty()) {
+            ++failed;
+            std::printf("%-40s FAILED: %s\n", name.c_str(), o.error.c_str());
+            all.push_back({{"input", o.input}, {"error", o.error}});
+            continue;
+        }
+        std::size_t before = 0, after = 0;
+        for (const LayerSimplifyReport& l : o.report->layers) {
+            before += l.before;
+            after += l.after;
+        }
+        if (!o.report->collision_free) ++tangled;
+        std::printf("%-40s %8zu %8zu %7zu %7zu %8zu %9.3g %8.3f\n", name.c_str(), before, after,
+                    o.naive->crossings, o.report->crossings, o.report->refused,
+                    max_hausdorff(*o.report), o.report->seconds_total);
+        nlohmann::json j = report_json(*o.report, &*o.naive);
+        j["input"] = o.input;
+        j["output"] = o.output;
+        all.push_back(j);
+    }
+    std::printf(
+        "%zu slices: %zu simplified, %zu failed (nothing written for them), %zu not "
+        "collision-free\n",
+        outcomes.size(), outcomes.size() - failed, failed, tangled);
+    if (!opt.report.empty()) write_file_atomic(opt.report, all.dump(2) + "\n");
+    return failed == 0 && tangled == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+Run add_simplify_command(CLI::App& app) {
+    auto opt = std::make_shared<SimplifyOptions>();
+    SimplifyParams& p = opt->params;
+    UntangleParams& u = p.untangling;
+    CLI::App* cmd = app.add_subcommand("simplify",
+                                       "Collision-free simplification. No input: the built-in "
+                                       "demo, outputs in strata-demo/ (or -o FOLDER). "
+                                       "Several inputs or a folder: a batch into -o FOLDER.");
+    cmd->add_option("inputs", opt->inputs, "Scene files (.json, .svg) or folders");
+    cmd->add_option("-o,--output", opt->output,
+                    "Output scene (one input), or folder (demo, batch)");
+    cmd->add_option("--remove", p.remove, "Fraction of each layer's vertices to remove")
+        ->capture_default_str();
+    cmd->add_option("--keep", p.keep, "Vertices to keep per layer (instead of --remove)");
+    cmd->add_option("--max-error", p.max_error,
+                    "Never leave an input vertex farther than this (scene units)");
+    CLI::Option* decimator =
+        cmd->add_option("--decimator", p.decimator,
+                        "random | visvalingam | max-error (demo: random, as in the paper)")
+            ->capture_default_str();
+    cmd->add_option("--seed", p.seed, "Seed of the random decimator")->capture_default_str();
+    cmd->add_option("--n-out", p.n_out, "N_out: fixed collar vertices around each piece")
+        ->capture_default_str();
+    add_backend_option(*cmd, u.field.backend);
+    cmd->add_option("--alpha", u.alpha, "Shape-matching stiffness")->capture_default_str();
+    cmd->add_option("--beta", u.beta, "Quadratic share of shape matching")->capture_default_str();
+    cmd->add_option("--gradient-steps", u.gradient_steps, "N_gd")->capture_default_str();
+    cmd->add_option("--tolerance", u.tolerance, "epsilon, relative to the scene diagonal")
+        ->capture_default_str();
+    cmd->add_option("--max-rounds", u.max_rounds, "Rounds per untangling pass")
+        ->capture_default_str();
+    cmd->add_option("--thickness", opt->thickness,
+                    "Thickness for layers whose thickness is 0 (scene units)");
+    cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")
+        ->capture_default_str();
+    cmd->add_flag("--global", p.global,
+                  "Untangle the whole scene after each tangling removal (slow; comparison)");
+    cmd->add_flag("--no-untangle", opt->naive, "Naive decimation only");
+    cmd->add_flag("--no-shape-matching", opt->no_shape_matching, "Pure projection");
+    cmd->add_option("--svg", opt->svg, "Picture: input / naive / strata (one input)");
+    cmd->add_option("--report", opt->report, "Report as JSON");
+    return [opt, decimator]() {
+        SimplifyOptions o = *opt;
+        if (o.inputs.empty() && decimator->count() == 0) o.params.decimator = "random";
+        if (o.no_shape_matching) o.params.untangling.shape = ShapeMode::None;
+        validate(o.params);
+        if (o.threads < 0)
+            throw InvalidInput("simplify: --threads must be >= 0 (got " +
+                               std::to_string(o.threads) + ")");
+        std::optional<tbb::global_control> limit;
+        if (o.threads > 0)
+            limit.emplace(tbb::global_control::max_allowed_parallelism,
+                          static_cast<std::size_t>(o.threads));
+        if (o.inputs.empty()) return run_demo(o);
+        const std::vector<std::string> files = expand_inputs(o.inputs);
+        if (files.size() > 1 || fs::is_directory(o.inputs.front())) return run_batch(o, files);
+
+        if (o.output.empty()) throw InvalidInput("simplify: -o OUT is required with one input");
+        check_outputs({o.output, o.svg, o.report}, files);
+        scene_format(o.output);
+        const Scene input = with_default_thickness(read_scene(files.front()), o.thickness);
+        for (const std::string& note : input.diagnostics().notes)
+            std::cerr << "strata: note: " << files.front() << ": " << note << '\n';
+        Scene result, naive;
+        const Outcome out = run_one(input, o, terminal_progress(), result, &naive);
+        write_scene(result, o.output);
+        if (!o.svg.empty()) {
+            SvgWriteParams svg;
+            svg.width_px = 1000.0;
+            write_file_atomic(
+                o.svg, panels_to_svg({{"input", &input, nullptr},
+                                      {"naive decimation", &naive, &input},
+                                      {o.naive ? "naive decimation" : "strata", &result, &input}},
+                                     svg));
+        }
+        if (!o.report.empty())
+            write_file_atomic(o.report, report_json(*out.report, &*out.naive).dump(2) + "\n");
+        print_summary(fs::path(files.front()).filename().string(), *out.report, &*out.naive);
+        return out.report->collision_free ? 0 : 1;
+    };
+}
+
+}  // namespace strata::cli

@@ -1,0 +1,141 @@
+// strata untangle: global untangling of a scene that is already tangled.
+#include "cli_util.h"
+#include "commands.h"
+
+#include "strata/geometry/checks.h"
+#include "strata/io/atomic_file.h"
+#include "strata/io/scene_io.h"
+#include "strata/io/svg_io.h"
+#include "strata/untangle/untangle.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace strata::cli {
+
+namespace {
+
+struct UntangleOptions {
+    std::string input, output, svg, report;
+    double thickness = 0.0;
+    bool no_shape_matching = false;
+    UntangleParams params;
+};
+
+Scene with_default_thickness(const Scene& scene, double thickness) {
+    if (thickness <= 0.0) return scene;
+    std::vector<Layer> layers = scene.layers();
+    for (Layer& layer : layers)
+        if (layer.thickness == 0.0) layer.thickness = thickness;
+    Scene out(std::move(layers), scene.units());
+    out.metadata = scene.metadata;
+    return out;
+}
+
+}  // namespace
+
+Run add_untangle_command(CLI::App& app) {
+    auto opt = std::make_shared<UntangleOptions>();
+    UntangleParams& p = opt->params;
+    CLI::App* cmd = app.add_subcommand("untangle",
+                                       "Untangle a scene whose layers cross or are too close (exit "
+                                       "0 when the result is collision-free)");
+    cmd->add_option("input", opt->input, "Scene file (.json or .svg)")->required();
+    cmd->add_option("-o,--output", opt->output, "Untangled scene (.json or .svg)")->required();
+    cmd->add_option("--svg", opt->svg, "Picture: the result over the input (faint)");
+    cmd->add_option("--report", opt->report, "Report as JSON");
+    cmd->add_option("--thickness", opt->thickness,
+                    "Thickness for layers whose thickness is 0 (scene units)")
+        ->capture_default_str();
+    add_backend_option(*cmd, p.field.backend);
+    cmd->add_option("--alpha", p.alpha, "Shape-matching stiffness (layers without their own)")
+        ->capture_default_str();
+    cmd->add_option("--beta", p.beta, "Quadratic share of shape matching")->capture_default_str();
+    cmd->add_option("--gradient-steps", p.gradient_steps,
+                    "N_gd: projection steps per shape matching")
+        ->capture_default_str();
+    cmd->add_option("--tolerance", p.tolerance,
+                    "epsilon: convergence speed, relative to the scene diagonal")
+        ->capture_default_str();
+    cmd->add_option("--max-rounds", p.max_rounds, "Cap on rounds per pass")->capture_default_str();
+    cmd->add_option("--max-passes", p.max_passes, "Field rebuilds when a pass ends tangled")
+        ->capture_default_str();
+    cmd->add_option("--voxel", p.field.voxel_size, "Grid voxel size (scene units; 0 = auto)")
+        ->capture_default_str();
+    cmd->add_flag("--no-shape-matching", opt->no_shape_matching,
+                  "Pure projection (the paper's Fig. 2 artefacts)");
+    return [opt]() {
+        UntangleParams params = opt->params;
+        if (opt->no_shape_matching) params.shape = ShapeMode::None;
+        validate(params);
+        check_outputs({opt->output, opt->svg, opt->report}, {opt->input});
+        scene_format(opt->output);  // reject a bad extension before working
+        const Scene input = with_default_thickness(read_scene(opt->input), opt->thickness);
+        for (const std::string& note : input.diagnostics().notes)
+            std::cerr << "strata: note: " << opt->input << ": " << note << '\n';
+        Scene scene = input;
+        const auto start = std::chrono::steady_clock::now();
+        const UntangleReport r = untangle(scene, params, terminal_progress());
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const CheckReport after = check_scene(scene);
+
+        write_scene(scene, opt->output);
+        if (!opt->svg.empty()) {
+            SvgWriteParams svg;
+            svg.underlay = &input;
+            write_scene_svg(scene, opt->svg, svg);
+        }
+        if (!opt->report.empty()) {
+            nlohmann::json j = {
+                {"input", opt->input},
+                {"output", opt->output},
+                {"backend", backend_name(params.field.backend)},
+                {"passes", r.passes},
+                {"rounds", r.rounds},
+                {"converged", r.converged},
+                {"collision_free", r.collision_free},
+                {"free_vertices", r.free_vertices},
+                {"moved_vertices", r.moved_vertices},
+                {"max_displacement", r.max_displacement},
+                {"crossings_before", r.crossings_before},
+                {"crossings_after", r.crossings_after},
+                {"nesting_violations_after", after.nesting_violation_count},
+                {"min_separation_ratio_after", std::isfinite(r.min_separation_ratio_after)
+                                                   ? nlohmann::json(r.min_separation_ratio_after)
+                                                   : nlohmann::json(nullptr)},
+                {"seconds",
+                 {{"fields", r.seconds_fields},
+                  {"untangle", r.seconds_untangle},
+                  {"check", r.seconds_check},
+                  {"total", seconds}}}};
+            write_file_atomic(opt->report, j.dump(2) + "\n");
+        }
+        std::printf("%s -> %s: %zu layers, %zu vertices\n", opt->input.c_str(), opt->output.c_str(),
+                    scene.size(), scene.vertex_count());
+        std::printf(
+            "crossings between layers: %zu before, %zu after; nesting violations after: %zu\n",
+            r.crossings_before, r.crossings_after, after.nesting_violation_count);
+        std::printf(
+            "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
+            "%.4g\n",
+            r.min_separation_ratio_after, r.moved_vertices, r.free_vertices, r.max_displacement);
+        std::printf(
+            "passes: %d, rounds: %d, %s; time %.3f s (fields %.3f, untangle %.3f, check %.3f)\n",
+            r.passes, r.rounds, r.converged ? "converged" : "NOT converged (round cap)", seconds,
+            r.seconds_fields, r.seconds_untangle, r.seconds_check);
+        if (!r.collision_free)
+            std::fprintf(
+                stderr,
+                "strata: warning: the result is NOT collision-free (see 'strata check %s')\n",
+                opt->output.c_str());
+        return r.collision_free ? 0 : 1;
+    };
+}
+
+}  // namespace strata::cli

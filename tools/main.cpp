@@ -1,0 +1,52 @@
+// strata: the command-line front end. Each verb lives in its own cmd_*.cpp.
+#include "commands.h"
+
+#include "strata/core/error.h"
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <map>
+#include <string>
+
+int main(int argc, char** argv) {
+    CLI::App app{"strata: collision-free simplification of 2D multi-layered shapes"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "strata 0.1.0");
+    std::map<std::string, strata::cli::Run> verbs;
+    verbs["check"] = strata::cli::add_check_command(app);
+    verbs["slice"] = strata::cli::add_slice_command(app);
+    verbs["untangle"] = strata::cli::add_untangle_command(app);
+    verbs["simplify"] = strata::cli::add_simplify_command(app);
+    verbs["grid"] = strata::cli::add_grid_command(app);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "strata: error: " << e.what() << "\n(run 'strata --help' for usage)\n";
+        return 2;
+    }
+    try {
+        for (auto& [name, run] : verbs)
+            if (app.got_subcommand(name)) return run();
+    } catch (const strata::InvalidInput& e) {
+        std::cerr << "strata: error: " << e.what() << '\n';
+        return 2;
+    } catch (const strata::IoError& e) {
+        std::cerr << "strata: error: " << e.what() << '\n';
+        return 2;
+    } catch (const strata::Cancelled& e) {
+        std::cerr << "strata: error: " << e.what() << '\n';
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "strata: error: internal: " << e.what() << '\n';
+        return 1;
+    }
+    return 2;
+}
