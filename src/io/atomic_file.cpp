@@ -17,7 +17,8 @@ std::string read_text_file(const fs::path& path) {
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw IoError(path.string() + ": is a directory, not a file");
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw IoError(path.string() + ": cannot open for reading (" + std::strerror(errno) + ")");
+    if (!in)
+        throw IoError(path.string() + ": cannot open for reading (" + std::strerror(errno) + ")");
     std::ostringstream buffer;
     buffer << in.rdbuf();
     if (in.bad()) throw IoError(path.string() + ": read failed");
@@ -28,9 +29,11 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
     const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
-        throw IoError(path.string() + ": cannot write, folder '" + dir.string() + "' does not exist");
+        throw IoError(path.string() + ": cannot write, folder '" + dir.string() +
+                      "' does not exist");
     std::random_device entropy;
-    const fs::path temp = dir / ("." + path.filename().string() + ".tmp" + std::to_string(entropy()));
+    const fs::path temp =
+        dir / ("." + path.filename().string() + ".tmp" + std::to_string(entropy()));
     {
         std::ofstream out(temp, std::ios::binary | std::ios::trunc);
         if (!out)

@@ -56,7 +56,8 @@ class Reader {
         layer.name = "layer_" + std::to_string(index);
         std::string label = where;
         if (auto it = object.find("name"); it != object.end()) {
-            if (!it->is_string()) fail(where + ".name", "expected a string (got " + shown(*it) + ")");
+            if (!it->is_string())
+                fail(where + ".name", "expected a string (got " + shown(*it) + ")");
             layer.name = it->get<std::string>();
             label = where + " ('" + layer.name + "')";
         }
@@ -68,7 +69,8 @@ class Reader {
             if (key == "name") {
                 continue;
             } else if (key == "closed") {
-                if (!value.is_boolean()) fail(at, "expected true or false (got " + shown(value) + ")");
+                if (!value.is_boolean())
+                    fail(at, "expected true or false (got " + shown(value) + ")");
                 layer.closed = value.get<bool>();
             } else if (key == "thickness") {
                 layer.thickness = number(value, at);
@@ -79,7 +81,8 @@ class Reader {
             } else if (key == "beta") {
                 if (!value.is_null()) layer.beta = number(value, at);
             } else if (key == "outer") {
-                if (!value.is_array()) fail(at, "expected an array of layer names (got " + shown(value) + ")");
+                if (!value.is_array())
+                    fail(at, "expected an array of layer names (got " + shown(value) + ")");
                 std::vector<std::string> names;
                 for (std::size_t k = 0; k < value.size(); ++k) {
                     if (!value[k].is_string())
@@ -90,7 +93,8 @@ class Reader {
                 layer.outer = std::move(names);
             } else if (key == "points") {
                 has_points = true;
-                if (!value.is_array()) fail(at, "expected an array of [x, y] (got " + shown(value) + ")");
+                if (!value.is_array())
+                    fail(at, "expected an array of [x, y] (got " + shown(value) + ")");
                 layer.points.reserve(value.size());
                 for (std::size_t k = 0; k < value.size(); ++k) {
                     const json& p = value[k];
@@ -122,7 +126,8 @@ class Reader {
         } catch (const json::exception& e) {  // e.g. a number too large for a double
             throw InvalidInput(source_ + ": invalid JSON: " + e.what());
         }
-        if (!root.is_object()) fail("top level", "expected an object with \"layers\" (got " + shown(root) + ")");
+        if (!root.is_object())
+            fail("top level", "expected an object with \"layers\" (got " + shown(root) + ")");
         std::string units;
         std::map<std::string, std::string> metadata;
         const json* layers = nullptr;
@@ -130,7 +135,8 @@ class Reader {
             const std::string& key = it.key();
             if (key == "strata") {
                 if (!it->is_number_integer() || it->get<long long>() != 1)
-                    fail("strata", "unsupported format version " + shown(*it) + " (this reader knows 1)");
+                    fail("strata",
+                         "unsupported format version " + shown(*it) + " (this reader knows 1)");
             } else if (key == "units") {
                 if (!it->is_string()) fail("units", "expected a string (got " + shown(*it) + ")");
                 units = it->get<std::string>();
@@ -149,7 +155,8 @@ class Reader {
         std::vector<std::string> kept;
         for (const auto& [key, value] : metadata) kept.push_back("\"" + key + "\"");
         for (const Layer& l : parsed)
-            for (const auto& [key, value] : l.extra) kept.push_back("'" + l.name + "'.\"" + key + "\"");
+            for (const auto& [key, value] : l.extra)
+                kept.push_back("'" + l.name + "'.\"" + key + "\"");
 
         Scene scene;
         try {
@@ -171,7 +178,9 @@ class Reader {
     std::string source_;
 };
 
-std::string quoted(const std::string& s) { return json(s).dump(); }
+std::string quoted(const std::string& s) {
+    return json(s).dump();
+}
 
 }  // namespace
 
@@ -187,7 +196,8 @@ std::string scene_to_json(const Scene& scene) {
     for (std::size_t i = 0; i < scene.size(); ++i) {
         const Layer& layer = scene.layer(i);
         out += i == 0 ? "\n" : ",\n";
-        out += "    {\"name\": " + quoted(layer.name) + ", \"closed\": " + (layer.closed ? "true" : "false") +
+        out += "    {\"name\": " + quoted(layer.name) +
+               ", \"closed\": " + (layer.closed ? "true" : "false") +
                ", \"thickness\": " + format_number(layer.thickness) +
                ", \"weight\": " + format_number(layer.weight);
         if (layer.alpha) out += ", \"alpha\": " + format_number(*layer.alpha);

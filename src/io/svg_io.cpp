@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
 #include <glm/geometric.hpp>
 #include <initializer_list>
@@ -109,8 +110,12 @@ struct OutputMap {
 // ---------------------------------------------------------------------------------------------
 // Numbers (SVG grammar: sign? (digits ("." digits?)? | "." digits) ([eE] sign? digits)?)
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f'; }
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
+bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f';
+}
+bool is_digit(char c) {
+    return c >= '0' && c <= '9';
+}
 
 class Scanner {
   public:
@@ -437,7 +442,9 @@ class PathBuilder {
 // ---------------------------------------------------------------------------------------------
 // d="..."
 
-bool is_command(char c) { return std::strchr("MmLlHhVvZzCcSsQqTtAa", c) != nullptr && c != '\0'; }
+bool is_command(char c) {
+    return std::strchr("MmLlHhVvZzCcSsQqTtAa", c) != nullptr && c != '\0';
+}
 
 std::size_t argument_count(char upper) {
     switch (upper) {
@@ -959,7 +966,8 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
     const double view_w = size.x + 2.0 * margin, view_h = size.y + 2.0 * margin;
     const double height_px = params.width_px * view_h / view_w;
     const double px = view_w / params.width_px;  // user units per pixel
-    const std::string stroke = format_number(params.stroke_px);
+    // In user units, so that viewers without vector-effect support draw the same width.
+    const std::string stroke = format_number(params.stroke_px * px);
 
     std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg";
     out += attribute("xmlns", "http://www.w3.org/2000/svg");
@@ -989,8 +997,7 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
         for (const Layer& layer : params.underlay->layers()) {
             out += "  <" + std::string(element_name(layer)) +
                    attribute("points", points_text(layer)) + attribute("stroke-width", stroke) +
-                   attribute("vector-effect", "non-scaling-stroke") + "><title>" +
-                   xml_escape("underlay " + layer_summary(layer)) + "</title></" +
+                   "><title>" + xml_escape("underlay " + layer_summary(layer)) + "</title></" +
                    element_name(layer) + ">\n";
         }
         out += "</g>\n";
@@ -1003,7 +1010,6 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
                attribute("points", points_text(layer)) + attribute("fill", "none") +
                attribute("stroke", colour) + attribute("stroke-width", stroke) +
                attribute("stroke-linejoin", "round") +
-               attribute("vector-effect", "non-scaling-stroke") +
                attribute("data-thickness", format_number(layer.thickness)) +
                attribute("data-weight", format_number(layer.weight));
         if (layer.alpha) out += attribute("data-alpha", format_number(*layer.alpha));
@@ -1019,6 +1025,62 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
         if (params.draw_vertices) out += dots(layer, colour);
     }
     out += "</svg>\n";
+    return out;
+}
+
+namespace {
+
+// The height attribute (pixels) of the first <svg> element of `svg`.
+double svg_height(const std::string& svg) {
+    const std::size_t at = svg.find(" height=\"");
+    return at == std::string::npos ? 0.0 : std::strtod(svg.c_str() + at + 9, nullptr);
+}
+
+}  // namespace
+
+std::string panels_to_svg(const std::vector<SvgPanel>& panels, const SvgWriteParams& params) {
+    validate(params);
+    if (panels.empty()) throw InvalidInput("panels_to_svg: no panel");
+    Box2 box;
+    for (std::size_t i = 0; i < panels.size(); ++i) {
+        if (!panels[i].scene)
+            throw InvalidInput("panels_to_svg: panels[" + std::to_string(i) + "] has no scene");
+        box.extend(panels[i].scene->bounds());
+    }
+    const bool stacked = box.size().x > box.size().y;
+    const double caption = 24.0, gap = 8.0;
+    double total_w = 0.0, total_h = 0.0;
+    std::string body;
+    for (const SvgPanel& panel : panels) {
+        SvgWriteParams one = params;
+        one.underlay = panel.underlay;
+        std::string svg = scene_to_svg(*panel.scene, one);
+        svg = svg.substr(svg.find("<svg"));  // drop the XML declaration
+        const double h = svg_height(svg);
+        const double x = stacked ? 0.0 : total_w, y = stacked ? total_h : 0.0;
+        body += "<text" + attribute("x", format_number(x + 4.0)) +
+                attribute("y", format_number(y + caption - 6.0)) +
+                attribute("font-family", "sans-serif") + attribute("font-size", "16") + ">" +
+                xml_escape(panel.title) + "</text>\n";
+        body += "<g" +
+                attribute("transform", "translate(" + format_number(x) + " " +
+                                           format_number(y + caption) + ")") +
+                ">\n" + svg + "</g>\n";
+        if (stacked) {
+            total_w = std::max(total_w, params.width_px);
+            total_h += caption + h + gap;
+        } else {
+            total_w += params.width_px + gap;
+            total_h = std::max(total_h, caption + h);
+        }
+    }
+    std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg";
+    out += attribute("xmlns", "http://www.w3.org/2000/svg");
+    out += attribute("version", "1.1");
+    out += attribute("width", format_number(total_w));
+    out += attribute("height", format_number(total_h));
+    out += ">\n<rect" + attribute("width", "100%") + attribute("height", "100%") +
+           attribute("fill", "white") + "/>\n" + body + "</svg>\n";
     return out;
 }
 

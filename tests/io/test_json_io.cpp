@@ -58,7 +58,8 @@ TEST_CASE("the documented example parses with every field", "[io][json]") {
     CHECK(scene.metadata.at("producer") == R"({"tool":"x","version":3})");
     CHECK(scene.layer(1).extra.at("colour") == "\"red\"");
     REQUIRE_FALSE(scene.diagnostics().notes.empty());
-    CHECK_THAT(scene.diagnostics().notes.back(), Contains("\"producer\"") && Contains("\"colour\""));
+    CHECK_THAT(scene.diagnostics().notes.back(),
+               Contains("\"producer\"") && Contains("\"colour\""));
 }
 
 TEST_CASE("JSON round trips are exact", "[io][json]") {
@@ -73,10 +74,10 @@ TEST_CASE("JSON round trips are exact", "[io][json]") {
         require_same(scene, parse_scene_json(scene_to_json(scene)));
     }
     SECTION("every real slice") {
-        for (const char* name :
-             {"cipc_multilayer_y+0.00.json", "cipc_multilayer_y-0.15.json", "cipc_multilayer_y-0.30.json",
-              "mh_casualsuit03_y+1.50.json", "mh_casualsuit03_y+4.00.json", "mh_casualsuit05_y+4.00.json",
-              "mh_elegantsuit01_y+0.50.json", "mh_elegantsuit01_y+1.50.json"}) {
+        for (const char* name : {"cipc_multilayer_y+0.00.json", "cipc_multilayer_y-0.15.json",
+                                 "cipc_multilayer_y-0.30.json", "mh_casualsuit03_y+1.50.json",
+                                 "mh_casualsuit03_y+4.00.json", "mh_casualsuit05_y+4.00.json",
+                                 "mh_elegantsuit01_y+0.50.json", "mh_elegantsuit01_y+1.50.json"}) {
             INFO(name);
             const Scene scene = read_scene_json(test::test_data(std::string("slices/") + name));
             CHECK_FALSE(scene.is_implicit_stack());
@@ -87,8 +88,10 @@ TEST_CASE("JSON round trips are exact", "[io][json]") {
 }
 
 TEST_CASE("bad JSON names the file, line and column", "[io][json]") {
-    CHECK_THROWS_WITH(parse_scene_json("{\n  \"layers\": [\n    {\"points\": [[0, 0], [1 1]]}\n  ]\n}", "bad.json"),
-                      Contains("bad.json:3:") && Contains("invalid JSON"));
+    CHECK_THROWS_WITH(
+        parse_scene_json("{\n  \"layers\": [\n    {\"points\": [[0, 0], [1 1]]}\n  ]\n}",
+                         "bad.json"),
+        Contains("bad.json:3:") && Contains("invalid JSON"));
     CHECK_THROWS_WITH(parse_scene_json("{\"layers\": [", "cut.json"), Contains("cut.json:1:13"));
 }
 
@@ -104,13 +107,16 @@ TEST_CASE("bad content names the layer, the key and the value", "[io][json]") {
     };
     CHECK_THAT(fails(R"({"layers": [{"name": "a", "points": [[0, 0], [1, "x"]]}]})"),
                Contains("f.json") && Contains("('a').points[1]") && Contains("[1,\"x\"]"));
-    CHECK_THAT(fails(R"({"layers": [{"name": "a", "thickness": "thick", "points": [[0, 0], [1, 0]]}]})"),
-               Contains("('a').thickness") && Contains("\"thick\""));
-    CHECK_THAT(fails(R"({"layers": [{"name": "a", "thickness": -2, "points": [[0, 0], [1, 0]]}]})"),
-               Contains("f.json") && Contains("layer 'a'") && Contains("thickness") && Contains("got -2"));
+    CHECK_THAT(
+        fails(R"({"layers": [{"name": "a", "thickness": "thick", "points": [[0, 0], [1, 0]]}]})"),
+        Contains("('a').thickness") && Contains("\"thick\""));
+    CHECK_THAT(
+        fails(R"({"layers": [{"name": "a", "thickness": -2, "points": [[0, 0], [1, 0]]}]})"),
+        Contains("f.json") && Contains("layer 'a'") && Contains("thickness") && Contains("got -2"));
     CHECK_THAT(fails(R"({"layers": [{"name": "a", "closed": 1, "points": [[0, 0], [1, 0]]}]})"),
                Contains("('a').closed") && Contains("true or false"));
-    CHECK_THAT(fails(R"({"layers": [{"name": "a"}]})"), Contains("('a')") && Contains("missing \"points\""));
+    CHECK_THAT(fails(R"({"layers": [{"name": "a"}]})"),
+               Contains("('a')") && Contains("missing \"points\""));
     CHECK_THAT(fails(R"({"layers": [{"name": "a", "outer": ["b"], "points": [[0, 0], [1, 0]]}]})"),
                Contains("'b'") && Contains("not a layer"));
     CHECK_THAT(fails(R"({"strata": 2, "layers": []})"), Contains("unsupported format version 2"));
@@ -132,8 +138,10 @@ TEST_CASE("writing is atomic and never overwrites an input", "[io][json]") {
     CHECK_THROWS_AS(ensure_not_an_input(file, {dir / "other.json", file}), InvalidInput);
     CHECK_NOTHROW(ensure_not_an_input(dir / "new.json", {file}));
     // A write into a missing folder fails cleanly and leaves nothing behind.
-    CHECK_THROWS_WITH(write_scene_json(scene, dir / "missing" / "x.json"), Contains("does not exist"));
+    CHECK_THROWS_WITH(write_scene_json(scene, dir / "missing" / "x.json"),
+                      Contains("does not exist"));
     CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
-    CHECK_THROWS_WITH(read_scene_json(dir / "absent.json"), Contains("absent.json") && Contains("cannot open"));
+    CHECK_THROWS_WITH(read_scene_json(dir / "absent.json"),
+                      Contains("absent.json") && Contains("cannot open"));
     fs::remove_all(dir);
 }

@@ -242,7 +242,7 @@ TEST_CASE("cube (STL): OpenMesh merges the facets' corners into one loop", "[mes
     CHECK(std::abs(area(s.pieces[0].points)) == Approx(2.0));
 }
 
-TEST_CASE("cylinder (OBJ): a regular polygon; a ring on the plane gives exactly its vertices",
+TEST_CASE("cylinder (OBJ): a regular polygon, a ring on the plane gives exactly its vertices",
           "[mesh_slice]") {
     const std::size_t n = 24;
     const SliceMesh cyl =

@@ -29,7 +29,9 @@ Scene parse(const std::string& body, double tolerance = 0.01) {
     return parse_scene_svg(svg_doc(body), "test.svg", params);
 }
 
-std::vector<Vec2> pts(std::initializer_list<Vec2> list) { return list; }
+std::vector<Vec2> pts(std::initializer_list<Vec2> list) {
+    return list;
+}
 
 void require_points(const Layer& layer, const std::vector<Vec2>& expected) {
     REQUIRE(layer.points.size() == expected.size());
@@ -74,7 +76,9 @@ Vec2 quad(const Vec2& p0, const Vec2& p1, const Vec2& p2, double t) {
     return s * s * p0 + 2.0 * s * t * p1 + t * t * p2;
 }
 
-Vec2 flip(const Vec2& p) { return {p.x, -p.y}; }
+Vec2 flip(const Vec2& p) {
+    return {p.x, -p.y};
+}
 
 std::string error_of(const std::string& text) {
     try {
@@ -391,7 +395,8 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
         const std::string svg = scene_to_svg(scene);
         require_same_scene(scene, parse_scene_svg(svg, "circles.svg"));
         CHECK_THAT(svg, Contains("<polygon id=\"circle_0\""));
-        CHECK_THAT(svg, Contains("vector-effect=\"non-scaling-stroke\""));
+        // Stroke widths in user units: 1.5 px of an 800 px picture of a 3.85-unit view box.
+        CHECK_THAT(svg, Contains("stroke-width=\"0.0072187"));
         CHECK_THAT(svg, Contains("stroke=\"#1f77b4\""));
         CHECK_THAT(svg, Contains("stroke=\"#ff7f0e\""));
         CHECK_THAT(svg, Contains("width=\"800\""));

@@ -28,6 +28,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace strata {
 
@@ -50,10 +51,11 @@ Scene read_scene_svg(const std::filesystem::path& path, const SvgReadParams& par
 
 /// Parameters of scene_to_svg().
 struct SvgWriteParams {
-    const Scene* underlay = nullptr;  ///< Optional: drawn faintly under the scene (e.g. the original).
-    double width_px = 800.0;          ///< Width of the picture in pixels; height keeps the aspect.
-    double stroke_px = 1.5;           ///< Stroke width of the layers in pixels.
-    bool draw_vertices = false;       ///< Small dots at the vertices.
+    const Scene* underlay =
+        nullptr;                 ///< Optional: drawn faintly under the scene (e.g. the original).
+    double width_px = 800.0;     ///< Width of the picture in pixels; height keeps the aspect.
+    double stroke_px = 1.5;      ///< Stroke width of the layers in pixels.
+    bool draw_vertices = false;  ///< Small dots at the vertices.
 };
 
 /// Throws InvalidInput naming the first out-of-range field (width_px > 0, stroke_px >= 0).
@@ -63,6 +65,18 @@ void validate(const SvgWriteParams& params);
 /// with round-trip precision; the underlay is a <g data-strata-role="underlay"> that
 /// parse_scene_svg() skips. @throws InvalidInput bad params.
 std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params = {});
+/// One picture of a comparison (see panels_to_svg()).
+struct SvgPanel {
+    std::string title;                ///< Caption drawn above the picture.
+    const Scene* scene = nullptr;     ///< Drawn in colour.
+    const Scene* underlay = nullptr;  ///< Optional, drawn faintly under it.
+};
+
+/// Several scenes side by side (stacked vertically when they are wider than tall), each with
+/// its caption, e.g. before / naive / strata. Meant for looking, not for reading back.
+/// @throws InvalidInput when a panel has no scene or `params` is out of range.
+std::string panels_to_svg(const std::vector<SvgPanel>& panels, const SvgWriteParams& params = {});
+
 /// scene_to_svg() written atomically to `path`. @throws IoError.
 void write_scene_svg(const Scene& scene, const std::filesystem::path& path,
                      const SvgWriteParams& params = {});
