@@ -52,6 +52,16 @@ void add_backend_option(CLI::App& cmd, FieldBackend& backend) {
         ->default_str(backend_name(backend));
 }
 
+Scene with_default_thickness(const Scene& scene, double thickness) {
+    if (thickness <= 0.0) return scene;
+    std::vector<Layer> layers = scene.layers();
+    for (Layer& layer : layers)
+        if (layer.thickness == 0.0) layer.thickness = thickness;
+    Scene out(std::move(layers), scene.units());
+    out.metadata = scene.metadata;
+    return out;
+}
+
 const char* backend_name(FieldBackend backend) {
     switch (backend) {
         case FieldBackend::Grid:

@@ -4,6 +4,7 @@
 
 #include "strata/core/progress.h"
 #include "strata/field/field.h"
+#include "strata/geometry/scene.h"
 
 #include <CLI/CLI.hpp>
 
@@ -21,6 +22,10 @@ void check_outputs(const std::vector<std::string>& outputs, const std::vector<st
 
 /// Adds `--backend grid|exact|indexed` bound to `backend`.
 void add_backend_option(CLI::App& cmd, FieldBackend& backend);
+
+/// `scene` with `thickness` given to its layers of thickness 0 (`--thickness`); unchanged
+/// when `thickness` <= 0.
+Scene with_default_thickness(const Scene& scene, double thickness);
 
 /// "grid", "exact", "indexed".
 const char* backend_name(FieldBackend backend);

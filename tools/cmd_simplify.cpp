@@ -37,16 +37,6 @@ struct SimplifyOptions {
     SimplifyParams params;
 };
 
-Scene with_default_thickness(const Scene& scene, double thickness) {
-    if (thickness <= 0.0) return scene;
-    std::vector<Layer> layers = scene.layers();
-    for (Layer& layer : layers)
-        if (layer.thickness == 0.0) layer.thickness = thickness;
-    Scene out(std::move(layers), scene.units());
-    out.metadata = scene.metadata;
-    return out;
-}
-
 nlohmann::json finite_or_null(double v) {
     return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }

@@ -27,16 +27,6 @@ struct UntangleOptions {
     UntangleParams params;
 };
 
-Scene with_default_thickness(const Scene& scene, double thickness) {
-    if (thickness <= 0.0) return scene;
-    std::vector<Layer> layers = scene.layers();
-    for (Layer& layer : layers)
-        if (layer.thickness == 0.0) layer.thickness = thickness;
-    Scene out(std::move(layers), scene.units());
-    out.metadata = scene.metadata;
-    return out;
-}
-
 }  // namespace
 
 Run add_untangle_command(CLI::App& app) {
