@@ -118,6 +118,16 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             name.c_str(), r.refused);
 }
 
+// Simplification keeps a collision-free scene so; an input that already crosses is refused.
+void require_collision_free(const Scene& input, const std::string& name) {
+    const CheckReport before = check_scene(input);
+    if (!before.is_collision_free())
+        throw InvalidInput(name + ": input already crosses (" +
+                           std::to_string(before.crossing_count) + " crossings, " +
+                           std::to_string(before.nesting_violation_count) +
+                           " nesting violations); not simplified (run 'strata untangle' first)");
+}
+
 struct Outcome {
     std::string input, output;
     std::optional<SimplifyReport> report, naive;
@@ -199,12 +209,7 @@ int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files)
         try {
             ensure_not_an_input(o.output, {fs::path(files[i])});
             const Scene input = with_default_thickness(read_scene(files[i]), opt.thickness);
-            const CheckReport before = check_scene(input);
-            if (!before.is_collision_free())
-                throw InvalidInput("input already crosses (" +
-                                   std::to_string(before.crossing_count) + " crossings, " +
-                                   std::to_string(before.nesting_violation_count) +
-                                   " nesting violations); not simplified");
+            require_collision_free(input, files[i]);
             Scene result;
             Outcome r = run_one(input, opt, {}, result, nullptr);
             write_scene(result, o.output);
@@ -313,6 +318,7 @@ Run add_simplify_command(CLI::App& app) {
         const Scene input = with_default_thickness(read_scene(files.front()), o.thickness);
         for (const std::string& note : input.diagnostics().notes)
             std::cerr << "strata: note: " << files.front() << ": " << note << '\n';
+        require_collision_free(input, files.front());
         Scene result, naive;
         const Outcome out = run_one(input, o, terminal_progress(), result, &naive);
         write_scene(result, o.output);
