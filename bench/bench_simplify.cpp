@@ -33,34 +33,11 @@ long peak_rss_mb() {
     return usage.ru_maxrss / 1024;
 }
 
-// Layers offset along the normal of a folded curve (as the demo), `points` per layer.
-Scene folded_stack(std::size_t count, std::size_t points) {
-    const double spacing = 0.04, width = 10.0 * static_cast<double>(points) / 600.0;
-    std::vector<Layer> layers;
-    for (std::size_t k = 0; k < count; ++k) {
-        Layer layer;
-        layer.name = "L" + std::to_string(k);
-        layer.thickness = 0.01;
-        const double offset = spacing * static_cast<double>(k);
-        for (std::size_t i = 0; i < points; ++i) {
-            const double x = width * static_cast<double>(i) / static_cast<double>(points - 1);
-            const double y =
-                0.5 * std::sin(0.6 * x) + 0.18 * std::sin(2.3 * x + 0.5) + 0.07 * std::sin(6.1 * x);
-            const double d = 0.3 * std::cos(0.6 * x) + 0.414 * std::cos(2.3 * x + 0.5) +
-                             0.427 * std::cos(6.1 * x);
-            const double len = std::sqrt(1.0 + d * d);
-            layer.points.emplace_back(x - offset * d / len, y + offset / len);
-        }
-        layers.push_back(std::move(layer));
-    }
-    return Scene(std::move(layers));
-}
-
 // Paper section 5.2 on a Fig. 2-like configuration: the middle of five layers decimated
 // naively (every 40th vertex kept over a stretch) cuts through its neighbours; untangle it
 // globally and locally, 150 iterations (5 rounds of N_gd = 30) and to convergence.
 void paper() {
-    const Scene input = folded_stack(5, 2000);
+    const Scene input = folded_stack(5, 2000, 10.0 * 2000.0 / 600.0);
     std::vector<Layer> layers = input.layers();
     Layer& middle = layers[2];
     std::vector<Vec2> kept;
@@ -108,7 +85,8 @@ void scenes(std::size_t max_points) {
                 "rss MB");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
         for (std::size_t points = 1000; points <= max_points; points *= 10) {
-            const Scene input = folded_stack(count, points);
+            const Scene input =
+                folded_stack(count, points, 10.0 * static_cast<double>(points) / 600.0);
             for (double remove : {0.8, 0.9, 0.95}) {
                 SimplifyParams naive;
                 naive.decimator = "random";

@@ -16,41 +16,36 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// `count` layers offset along the normal of a folded curve (like the demo), open or closed.
-Scene folded_stack(std::size_t count, std::size_t points, bool closed, double spacing = 0.04,
-                   double thickness = 0.01) {
+// `count` closed wobbly loops offset outward along their normals (curvature radius > the
+// offsets), the closed counterpart of strata::folded_stack.
+Scene wobbly_loops(std::size_t count, std::size_t points, double spacing, double thickness) {
     std::vector<Layer> layers;
     for (std::size_t k = 0; k < count; ++k) {
         Layer layer;
         layer.name = "L" + std::to_string(k);
-        layer.closed = closed;
+        layer.closed = true;
         layer.thickness = thickness;
         const double offset = spacing * static_cast<double>(k);
         for (std::size_t i = 0; i < points; ++i) {
-            const double t =
-                static_cast<double>(i) / static_cast<double>(closed ? points : points - 1);
-            if (closed) {  // a wobbly loop, offset outward (curvature radius > the offsets)
-                const double a = 2.0 * kPi * t;
-                const double r = 1.0 + 0.06 * std::sin(5.0 * a) + 0.015 * std::sin(11.0 * a);
-                const double dr = 0.3 * std::cos(5.0 * a) + 0.165 * std::cos(11.0 * a);
-                const Vec2 p(r * std::cos(a), r * std::sin(a));
-                const Vec2 tangent(dr * std::cos(a) - r * std::sin(a),
-                                   dr * std::sin(a) + r * std::cos(a));
-                const Vec2 normal = glm::normalize(Vec2(tangent.y, -tangent.x));
-                layer.points.push_back(p + offset * normal);
-            } else {
-                const double x = 10.0 * t;
-                const double y = 0.5 * std::sin(0.6 * x) + 0.18 * std::sin(2.3 * x + 0.5) +
-                                 0.07 * std::sin(6.1 * x);
-                const double d = 0.3 * std::cos(0.6 * x) + 0.414 * std::cos(2.3 * x + 0.5) +
-                                 0.427 * std::cos(6.1 * x);
-                const double len = std::sqrt(1.0 + d * d);
-                layer.points.emplace_back(x - offset * d / len, y + offset / len);
-            }
+            const double a = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(points);
+            const double r = 1.0 + 0.06 * std::sin(5.0 * a) + 0.015 * std::sin(11.0 * a);
+            const double dr = 0.3 * std::cos(5.0 * a) + 0.165 * std::cos(11.0 * a);
+            const Vec2 p(r * std::cos(a), r * std::sin(a));
+            const Vec2 tangent(dr * std::cos(a) - r * std::sin(a),
+                               dr * std::sin(a) + r * std::cos(a));
+            const Vec2 normal = glm::normalize(Vec2(tangent.y, -tangent.x));
+            layer.points.push_back(p + offset * normal);
         }
         layers.push_back(std::move(layer));
     }
     return Scene(std::move(layers));
+}
+
+// Open (strata::folded_stack over x in [0, 10]) or closed (wobbly_loops) generated stacks.
+Scene stack(std::size_t count, std::size_t points, bool closed, double spacing = 0.04,
+            double thickness = 0.01) {
+    return closed ? wobbly_loops(count, points, spacing, thickness)
+                  : folded_stack(count, points, 10.0, spacing, thickness);
 }
 
 // The invariants of a collision-free simplification, checked exactly.
@@ -85,8 +80,7 @@ TEST_CASE("generated stacks simplify without collisions, naive decimation collid
           "[simplify][slow]") {
     for (const bool closed : {false, true}) {
         for (const std::size_t count : {std::size_t(5), std::size_t(8)}) {
-            const Scene input =
-                folded_stack(count, closed ? 240 : 200, closed, closed ? 0.025 : 0.04);
+            const Scene input = stack(count, closed ? 240 : 200, closed, closed ? 0.025 : 0.04);
             REQUIRE(check_scene(input).is_collision_free());
             for (const char* decimator : {"random", "visvalingam", "max-error"}) {
                 for (const double remove : {0.8, 0.9, 0.95}) {
@@ -113,7 +107,7 @@ TEST_CASE("generated stacks simplify without collisions, naive decimation collid
 }
 
 TEST_CASE("several seeds of random decimation", "[simplify]") {
-    const Scene input = folded_stack(5, 300, false);
+    const Scene input = stack(5, 300, false);
     for (std::uint64_t seed : {1u, 2u, 5u}) {
         INFO("seed " << seed);
         SimplifyParams params;
@@ -126,7 +120,7 @@ TEST_CASE("several seeds of random decimation", "[simplify]") {
 }
 
 TEST_CASE("the result is the same at 1 and 2 threads", "[simplify]") {
-    const Scene input = folded_stack(5, 300, false);
+    const Scene input = stack(5, 300, false);
     for (FieldBackend backend : {FieldBackend::Grid, FieldBackend::ExactIndexed}) {
         SimplifyParams params;
         params.decimator = "random";
@@ -167,7 +161,7 @@ TEST_CASE("every real slice simplifies without collisions (slow)", "[simplify][s
 
 TEST_CASE("shape matching keeps the vertices of a layer apart", "[simplify]") {
     // Paper, Fig. 2: without shape matching the projected vertices bunch up.
-    const Scene input = folded_stack(5, 300, false);
+    const Scene input = stack(5, 300, false);
     std::vector<double> lengths;
     for (const Layer& layer : input.layers())
         for (std::size_t i = 0; i + 1 < layer.points.size(); ++i)
@@ -188,7 +182,7 @@ TEST_CASE("shape matching keeps the vertices of a layer apart", "[simplify]") {
 }
 
 TEST_CASE("max-error bounds the naive decimation's Hausdorff distance", "[simplify]") {
-    const Scene input = folded_stack(3, 300, false);
+    const Scene input = stack(3, 300, false);
     SimplifyParams params;
     params.decimator = "max-error";
     params.remove = 1.0;

@@ -79,8 +79,15 @@ struct SimplifyReport {
 SimplifyReport simplify(Scene& scene, const SimplifyParams& params = {},
                         const ProgressFn& progress = {});
 
-/// The built-in demo: five stacked cloth-like open layers with folds (after the paper's
-/// Fig. 1), `points` vertices each, thickness 0.01, innermost first, one implicit stack.
+/// Generated test scene: `layers` open layers offset by `spacing` along the normal of one
+/// folded curve over x in [0, width] (y = 0.5 sin 0.6x + 0.18 sin(2.3x + 0.5) + 0.07 sin 6.1x),
+/// `points` vertices each, thickness `thickness`, innermost first, one implicit stack. Where
+/// the folds bend the layers come close, and a decimation that cuts a fold's corner cuts into
+/// the neighbouring layer. Lengths in scene units.
+Scene folded_stack(std::size_t layers, std::size_t points, double width = 10.0,
+                   double spacing = 0.04, double thickness = 0.01);
+
+/// The built-in demo (after the paper's Fig. 1): folded_stack(5, points), units "dm".
 Scene demo_scene(std::size_t points = 600);
 
 }  // namespace strata

@@ -43,7 +43,7 @@ struct UntangleParams {
     int max_rounds = 60;  ///< Cap on rounds per pass. >= 1.
     /// Passes: when a pass ends with the region still tangled, the fields are rebuilt from the
     /// current geometry and the untangling runs again. >= 1.
-    int max_passes = 4;
+    int max_passes = 8;
     /// Smallest separation the untangling aims for between any two constrained layers, scene
     /// units, >= 0, used where the thicknesses ask for less: layers of zero thickness would
     /// otherwise be projected onto each other and touch. 0 = automatic: 1% of the median
