@@ -2,6 +2,7 @@
 #include "strata/io/atomic_file.h"
 #include "strata/io/json_io.h"
 #include "support/fixtures.h"
+#include "support/require.h"
 
 #include <catch2/catch.hpp>
 
@@ -11,26 +12,6 @@ using namespace strata;
 using Catch::Matchers::Contains;
 
 namespace {
-
-void require_same(const Scene& a, const Scene& b) {
-    REQUIRE(a.size() == b.size());
-    CHECK(a.units() == b.units());
-    CHECK(a.metadata == b.metadata);
-    CHECK(a.is_implicit_stack() == b.is_implicit_stack());
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        const Layer& la = a.layer(i);
-        const Layer& lb = b.layer(i);
-        CHECK(la.name == lb.name);
-        CHECK(la.closed == lb.closed);
-        CHECK(la.thickness == lb.thickness);
-        CHECK(la.weight == lb.weight);
-        CHECK(la.alpha == lb.alpha);
-        CHECK(la.beta == lb.beta);
-        CHECK(la.outer == lb.outer);
-        CHECK(la.extra == lb.extra);
-        CHECK(la.points == lb.points);  // bit-exact
-    }
-}
 
 const char* kExample = R"({
   "strata": 1, "units": "m", "producer": {"tool": "x", "version": 3},
@@ -66,12 +47,12 @@ TEST_CASE("JSON round trips are exact", "[io][json]") {
     SECTION("generated scenes") {
         for (const Scene& scene : {test::nested_circles(3, 37, 1.0 / 3.0, 0.1, 0.01),
                                    test::stacked_sines(5, 101), test::spiral(3.5, 200)}) {
-            require_same(scene, parse_scene_json(scene_to_json(scene)));
+            test::require_same_scene(scene, parse_scene_json(scene_to_json(scene)), true);
         }
     }
     SECTION("a file with metadata, params and explicit nesting") {
         const Scene scene = parse_scene_json(kExample);
-        require_same(scene, parse_scene_json(scene_to_json(scene)));
+        test::require_same_scene(scene, parse_scene_json(scene_to_json(scene)), true);
     }
     SECTION("every real slice") {
         for (const char* name : {"cipc_multilayer_y+0.00.json", "cipc_multilayer_y-0.15.json",
@@ -82,7 +63,7 @@ TEST_CASE("JSON round trips are exact", "[io][json]") {
             const Scene scene = read_scene_json(test::test_data(std::string("slices/") + name));
             CHECK_FALSE(scene.is_implicit_stack());
             CHECK(scene.metadata.count("source") == 1);
-            require_same(scene, parse_scene_json(scene_to_json(scene)));
+            test::require_same_scene(scene, parse_scene_json(scene_to_json(scene)), true);
         }
     }
 }
@@ -134,7 +115,7 @@ TEST_CASE("writing is atomic and never overwrites an input", "[io][json]") {
     const fs::path file = dir / "scene.json";
     const Scene scene = test::nested_circles(2, 8);
     write_scene_json(scene, file);
-    require_same(scene, read_scene_json(file));
+    test::require_same_scene(scene, read_scene_json(file), true);
     CHECK_THROWS_AS(ensure_not_an_input(file, {dir / "other.json", file}), InvalidInput);
     CHECK_NOTHROW(ensure_not_an_input(dir / "new.json", {file}));
     // A write into a missing folder fails cleanly and leaves nothing behind.

@@ -11,6 +11,7 @@
 #include "strata/core/error.h"
 #include "strata/io/svg_io.h"
 #include "support/fixtures.h"
+#include "support/require.h"
 
 using namespace strata;
 using Catch::Matchers::Contains;
@@ -88,25 +89,6 @@ std::string error_of(const std::string& text) {
     }
     FAIL("no InvalidInput for:\n" << text);
     return {};
-}
-
-void require_same_scene(const Scene& a, const Scene& b) {
-    REQUIRE(a.size() == b.size());
-    CHECK(a.units() == b.units());
-    CHECK(a.is_implicit_stack() == b.is_implicit_stack());
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        const Layer& la = a.layer(i);
-        const Layer& lb = b.layer(i);
-        CHECK(la.name == lb.name);
-        CHECK(la.closed == lb.closed);
-        CHECK(la.thickness == lb.thickness);
-        CHECK(la.weight == lb.weight);
-        CHECK(la.alpha == lb.alpha);
-        CHECK(la.beta == lb.beta);
-        CHECK(la.outer == lb.outer);
-        CHECK(a.outer_of(i) == b.outer_of(i));
-        CHECK(la.points == lb.points);
-    }
 }
 
 Scene explicit_scene() {
@@ -393,7 +375,7 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
     SECTION("nested circles") {
         const Scene scene = test::nested_circles(4, 64, 1.0, 0.25, 0.01);
         const std::string svg = scene_to_svg(scene);
-        require_same_scene(scene, parse_scene_svg(svg, "circles.svg"));
+        test::require_same_scene(scene, parse_scene_svg(svg, "circles.svg"), false);
         CHECK_THAT(svg, Contains("<polygon id=\"circle_0\""));
         // Stroke widths in user units: 1.5 px of an 800 px picture of a 3.85-unit view box.
         CHECK_THAT(svg, Contains("stroke-width=\"0.0072187"));
@@ -412,7 +394,7 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
         const std::string svg = scene_to_svg(scene, params);
         CHECK_THAT(svg, Contains("<polyline id=\"sine_2\""));
         CHECK_THAT(svg, Contains("<circle"));
-        require_same_scene(scene, parse_scene_svg(svg, "sines.svg"));
+        test::require_same_scene(scene, parse_scene_svg(svg, "sines.svg"), false);
     }
     SECTION("explicit outer, parameters, units, names needing escapes") {
         const Scene scene = explicit_scene();
@@ -420,7 +402,7 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
         CHECK_THAT(svg, Contains("data-strata-units=\"cm\""));
         CHECK_THAT(svg, Contains("data-outer=\"coat\""));
         CHECK_THAT(svg, Contains("data-outer=\"\""));
-        require_same_scene(scene, parse_scene_svg(svg, "explicit.svg"));
+        test::require_same_scene(scene, parse_scene_svg(svg, "explicit.svg"), false);
 
         Layer odd = scene.layer(0);
         odd.name = "a&b<\"'>\n\tz";
@@ -428,7 +410,8 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
         Layer other = scene.layer(1);
         other.outer.reset();
         const Scene escaped({odd, other});
-        require_same_scene(escaped, parse_scene_svg(scene_to_svg(escaped), "escaped.svg"));
+        test::require_same_scene(escaped, parse_scene_svg(scene_to_svg(escaped), "escaped.svg"),
+                                 false);
     }
     SECTION("with an underlay, through files") {
         const Scene scene = test::nested_circles(2, 16);
@@ -443,7 +426,7 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
         write_scene_svg(scene, path, params);
         const Scene back = read_scene_svg(path);
         std::filesystem::remove(path);
-        require_same_scene(scene, back);
+        test::require_same_scene(scene, back, false);
     }
 }
 

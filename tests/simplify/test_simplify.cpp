@@ -3,6 +3,7 @@
 #include "strata/io/json_io.h"
 #include "strata/simplify/simplify.h"
 #include "support/fixtures.h"
+#include "support/require.h"
 
 #include <tbb/global_control.h>
 #include <catch2/catch.hpp>
@@ -50,13 +51,7 @@ Scene stack(std::size_t count, std::size_t points, bool closed, double spacing =
 
 // The invariants of a collision-free simplification, checked exactly.
 void require_valid(const Scene& input, const Scene& out, const SimplifyReport& r, double tol) {
-    CheckParams params;
-    params.separation_tolerance = tol;
-    const CheckReport check = check_scene(out, params);
-    CHECK(check.crossing_count == 0);
-    CHECK(check.total_self_crossings() == 0);
-    CHECK(check.nesting_violation_count == 0);
-    CHECK(check.separation_violation_count == 0);
+    test::require_collision_free(out, tol);
     CHECK(r.collision_free);
     CHECK(r.crossings == 0);
     for (std::size_t l = 0; l < out.size(); ++l) {

@@ -3,6 +3,7 @@
 #include "strata/io/json_io.h"
 #include "strata/untangle/untangle.h"
 #include "support/fixtures.h"
+#include "support/require.h"
 
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
@@ -34,16 +35,6 @@ double max_move(const Scene& a, const Scene& b, std::size_t layer) {
     return d;
 }
 
-void require_untangled(const Scene& scene, double tol = 0.1) {
-    CheckParams params;
-    params.separation_tolerance = tol;
-    const CheckReport check = check_scene(scene, params);
-    CHECK(check.crossing_count == 0);
-    CHECK(check.total_self_crossings() == 0);
-    CHECK(check.nesting_violation_count == 0);
-    CHECK(check.separation_violation_count == 0);
-}
-
 UntangleParams exact_params() {
     UntangleParams params;
     params.field.backend = FieldBackend::ExactIndexed;
@@ -64,7 +55,7 @@ TEST_CASE("an inner circle poking out of its outer circle is pulled back in", "[
         CHECK(report.crossings_before == 2);
         CHECK(report.crossings_after == 0);
         CHECK(report.collision_free);
-        require_untangled(scene);
+        test::require_collision_free(scene, 0.1);
     }
 }
 
@@ -76,7 +67,7 @@ TEST_CASE("a much heavier layer barely moves", "[untangle]") {
     const Scene before = heavy;
     untangle(light, exact_params());
     untangle(heavy, exact_params());
-    require_untangled(heavy);
+    test::require_collision_free(heavy, 0.1);
     CHECK(max_move(heavy, before, 1) < 0.05 * max_move(light, before, 1));
     CHECK(max_move(heavy, before, 0) > 0.09);  // the inner one made the room instead
 }
@@ -91,7 +82,7 @@ TEST_CASE("stacked open layers keep order and separation", "[untangle]") {
     REQUIRE(check_scene(scene).crossing_count > 0);
     const UntangleReport report = untangle(scene, exact_params());
     CHECK(report.collision_free);
-    require_untangled(scene);
+    test::require_collision_free(scene, 0.1);
 }
 
 TEST_CASE("two loops side by side inside a third stay apart and inside", "[untangle]") {
@@ -106,7 +97,7 @@ TEST_CASE("two loops side by side inside a third stay apart and inside", "[untan
     REQUIRE(before.crossing_count > 0);  // the legs overlap each other and poke out
     const UntangleReport report = untangle(scene, exact_params());
     CHECK(report.collision_free);
-    require_untangled(scene);
+    test::require_collision_free(scene, 0.1);
 }
 
 TEST_CASE("pure projection also untangles but does not keep the shape as well", "[untangle]") {
