@@ -31,21 +31,30 @@ class VertexGrid {
     void build(const Scene& scene, const Box2& region, double cell) {
         cell_ = cell;
         cells_.clear();
+        all_.clear();
         for (std::size_t l = 0; l < scene.size(); ++l) {
             const Layer& layer = scene.layer(l);
             if (!layer.bounds().overlaps(region)) continue;
             for (std::size_t v = 0; v < layer.points.size(); ++v)
-                if (region.contains(layer.points[v]))
+                if (region.contains(layer.points[v])) {
                     cells_[key(layer.points[v])].push_back({l, v});
+                    all_.push_back({layer.points[v], l, v});
+                }
         }
     }
 
-    // Calls f(layer, vertex) for the vertices in the cells that `box` touches.
+    // Calls f(layer, vertex) for the vertices in the cells that `box` touches, or, when the
+    // box spans more cells than there are vertices, for every vertex in the box.
     template <class F>
     void query(const Box2& box, F&& f) const {
         const auto x0 = coord(box.min.x), x1 = coord(box.max.x);
         const auto y0 = coord(box.min.y), y1 = coord(box.max.y);
-        if ((x1 - x0 + 1) * (y1 - y0 + 1) > 4096) return;  // a huge box: not worth it
+        if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) >
+            static_cast<double>(all_.size())) {
+            for (const Entry& e : all_)
+                if (box.contains(e.point)) f(e.layer, e.vertex);
+            return;
+        }
         for (auto ix = x0; ix <= x1; ++ix)
             for (auto iy = y0; iy <= y1; ++iy) {
                 auto it = cells_.find(pack(ix, iy));
@@ -62,8 +71,13 @@ class VertexGrid {
     }
     std::uint64_t key(const Vec2& p) const { return pack(coord(p.x), coord(p.y)); }
 
+    struct Entry {
+        Vec2 point;
+        std::size_t layer, vertex;
+    };
     double cell_ = 1.0;
     std::unordered_map<std::uint64_t, std::vector<std::pair<std::size_t, std::size_t>>> cells_;
+    std::vector<Entry> all_;
 };
 
 // The composed value and gradient of one layer at one point.
@@ -343,6 +357,12 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     result.seconds_check += seconds_since(start);
     result.converged = result.ok;  // nothing to do is a converged run
     const int total_rounds = params.max_rounds * params.max_passes;
+    std::vector<std::vector<Vec2>> rest;  // the pieces' shapes before any move
+    for (const Piece& piece : pieces) {
+        rest.emplace_back();
+        for (std::size_t v : piece.vertices)
+            rest.back().push_back(work.layer(piece.layer).points[v]);
+    }
     for (int pass = 0; pass < params.max_passes && !result.ok; ++pass) {
         ++result.passes;
         start = Clock::now();
@@ -355,21 +375,27 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                 : std::max(settings.min_separation, 0.25 * fields.params().voxel_size);
         start = Clock::now();
         Pass engine(work, relations, fields, params, separation, settings.sample_spacing);
-        std::vector<std::vector<Vec2>> rest;
-        for (const Piece& piece : pieces) {
-            rest.emplace_back();
-            for (std::size_t v : piece.vertices)
-                rest.back().push_back(work.layer(piece.layer).points[v]);
-        }
         result.converged = false;
         for (int round = 0; round < params.max_rounds; ++round) {
-            if (round > 0 && params.shape == ShapeMode::ShapeMatching)
+            // Shape matching toward the shape the engine started from, before every round
+            // but the very first: passes rebuild the fields, not the rest shape.
+            if ((pass > 0 || round > 0) && params.shape == ShapeMode::ShapeMatching)
                 engine.match_shapes(work, pieces, rest);
             // V (Eq. 7) of the round's last projection step: shape matching moves the
             // vertices at the start of every round, the projection must settle them again.
             double moved = 0.0;
-            for (int s = 0; s < params.gradient_steps; ++s) moved = engine.project(work, pieces);
+            for (int s = 0; s < params.gradient_steps && !result.ok; ++s) {
+                moved = engine.project(work, pieces);
+                if (settings.check_every_step && s + 1 < params.gradient_steps) {
+                    result.seconds_untangle += seconds_since(start);
+                    start = Clock::now();
+                    result.ok = is_ok(work);
+                    result.seconds_check += seconds_since(start);
+                    start = Clock::now();
+                }
+            }
             ++result.rounds;
+            if (result.ok) break;
             result.mean_speed = free_vertices ? moved / static_cast<double>(free_vertices) : 0.0;
             if (progress &&
                 !progress("untangle", static_cast<double>(result.rounds) / total_rounds))

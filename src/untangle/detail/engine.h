@@ -32,6 +32,9 @@ struct EngineSettings {
     double sample_spacing = 0.0;     ///< Resolved UntangleParams::sample_spacing.
     std::vector<int> outside_signs;  ///< Per work layer, see outside_side().
     double diagonal = 1.0;           ///< Scene scale for the tolerance.
+    /// Calls is_ok after every projection step rather than after every round: for callers
+    /// whose check is local and cheap, a region stops as soon as it is good.
+    bool check_every_step = false;
 };
 
 /// What run_engine() did.
