@@ -45,11 +45,10 @@ void add_backend_option(CLI::App& cmd, FieldBackend& backend) {
     static const std::map<std::string, FieldBackend> names{{"grid", FieldBackend::Grid},
                                                            {"exact", FieldBackend::ExactBrute},
                                                            {"indexed", FieldBackend::ExactIndexed}};
-    cmd.add_option("--backend", backend,
-                   "Field backend: grid (OpenVDB narrow band), exact (brute force) or indexed "
-                   "(exact, bucketed)")
-        ->transform(CLI::CheckedTransformer(names, CLI::ignore_case))
-        ->default_str(backend_name(backend));
+    add_choice_option(cmd, "--backend", backend, names,
+                      "Field backend: grid (OpenVDB narrow band), exact (brute force) or indexed "
+                      "(exact, bucketed)",
+                      backend_name(backend));
 }
 
 Scene with_default_thickness(const Scene& scene, double thickness) {

@@ -8,7 +8,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,27 @@ ProgressFn terminal_progress();
 
 /// Throws InvalidInput when an output would overwrite an input, or its folder is missing.
 void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
+
+/// Adds an option `name` taking one of the keys of `choices` (any case) and storing its value
+/// in `target`; a bad value is reported as "NAME: VALUE not in {a,b,...}".
+template <class T>
+CLI::Option* add_choice_option(CLI::App& cmd, const std::string& name, T& target,
+                               const std::map<std::string, T>& choices, const std::string& help,
+                               const std::string& default_name) {
+    std::vector<std::string> names;
+    for (const auto& entry : choices) names.push_back(entry.first);
+    return cmd
+        .add_option_function<std::string>(
+            name,
+            [&target, choices](std::string value) {
+                for (char& c : value)
+                    c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+                target = choices.at(value);
+            },
+            help)
+        ->check(CLI::IsMember(names, CLI::ignore_case))
+        ->default_str(default_name);
+}
 
 /// Adds `--backend grid|exact|indexed` bound to `backend`.
 void add_backend_option(CLI::App& cmd, FieldBackend& backend);

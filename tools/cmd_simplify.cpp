@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -55,6 +56,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"removed", r.removed},
                         {"untangle_calls", r.untangle_calls},
                         {"refused", r.refused},
+                        {"deferred", r.deferred},
                         {"rounds", r.rounds},
                         {"targets_met", r.targets_met},
                         {"crossings", r.crossings},
@@ -100,10 +102,11 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
         r.crossings, naive ? std::to_string(naive->nesting_violations).c_str() : "-",
         r.nesting_violations);
     std::printf(
-        "min separation ratio %.4g; max Hausdorff %.4g; removals %zu, untangled %zu, refused %zu; "
-        "time %.3f s (decimate %.3f, fields %.3f, untangle %.3f, check %.3f)\n",
-        r.min_separation_ratio, max_hausdorff(r), r.removed, r.untangle_calls, r.refused,
-        r.seconds_total, r.seconds_decimate, r.seconds_fields, r.seconds_untangle, r.seconds_check);
+        "min separation ratio %.4g; max Hausdorff %.4g; removals %zu, set aside %zu, untangled "
+        "%zu, refused %zu; time %.3f s (decimate %.3f, fields %.3f, untangle %.3f, check %.3f)\n",
+        r.min_separation_ratio, max_hausdorff(r), r.removed, r.deferred, r.untangle_calls,
+        r.refused, r.seconds_total, r.seconds_decimate, r.seconds_fields, r.seconds_untangle,
+        r.seconds_check);
     if (!r.collision_free)
         std::fprintf(
             stderr,
@@ -278,6 +281,13 @@ Run add_simplify_command(CLI::App& app) {
     cmd->add_option("--seed", p.seed, "Seed of the random decimator")->capture_default_str();
     cmd->add_option("--n-out", p.n_out, "N_out: fixed collar vertices around each piece")
         ->capture_default_str();
+    static const std::map<std::string, UntangleSchedule> schedules{
+        {"deferred", UntangleSchedule::Deferred}, {"immediate", UntangleSchedule::Immediate}};
+    add_choice_option(*cmd, "--schedule", p.schedule, schedules,
+                      "deferred: removals that need untangling wait until a layer cannot reach "
+                      "its target otherwise (fast); immediate: untangle after every such "
+                      "removal (the paper's Algorithm 1)",
+                      "deferred");
     add_backend_option(*cmd, u.field.backend);
     cmd->add_option("--alpha", u.alpha, "Shape-matching stiffness")->capture_default_str();
     cmd->add_option("--beta", u.beta, "Quadratic share of shape matching")->capture_default_str();

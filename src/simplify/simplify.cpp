@@ -172,9 +172,11 @@ class Driver {
         for (std::size_t a = 0; a < n; ++a) nest_thickness_[a] += scene.layer(a).thickness;
         stamp_.resize(n);
         for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
+        mark_ = stamp_;
         version_.resize(n);
         for (std::size_t l = 0; l < n; ++l) version_[l].assign(layers_[l].alive.size(), 0);
         if (params.untangle) settings_ = detail::resolve_settings(scene, params.untangling);
+
         report_.layers.resize(n);
     }
 
@@ -185,32 +187,49 @@ class Driver {
         for (std::size_t l = 0; l < layers_.size(); ++l)
             for (std::size_t v = 0; v < layers_[l].alive.size(); ++v) push(l, v);
         std::size_t done = 0, last_reported = 0;
-        while (!queue_.empty()) {
-            const Candidate c = queue_.top();
-            queue_.pop();
-            const std::size_t l = c.layer, v = c.vertex;
-            WorkLayer& w = layers_[l];
-            if (c.version != version_[l][v] || !removable(l, v) || w.alive_count <= w.target)
-                continue;
-            const std::size_t a = w.prev[v], b = w.next[v];
-            if (params_.max_error > 0.0 && span_error(view(l), a, b) > params_.max_error) {
-                w.locked[v] = 1;
-                continue;
+        // Deferred schedule: a first sweep removes what needs no untangling; a second one
+        // untangles, over the layers still above their target only.
+        defer_ = params_.untangle && params_.schedule == UntangleSchedule::Deferred;
+        for (int sweep = 0; sweep < (defer_ ? 2 : 1); ++sweep) {
+            if (sweep == 1) {
+                defer_ = false;
+                for (std::size_t l = 0; l < layers_.size(); ++l)
+                    if (layers_[l].alive_count > layers_[l].target)
+                        for (std::size_t v = 0; v < layers_[l].alive.size(); ++v) push(l, v);
             }
-            if (try_remove(l, v)) {
-                ++report_.removed;
-                ++done;
-            } else {
-                w.locked[v] = 1;
-                ++report_.refused;
-                ++report_.layers[l].refused;
-            }
-            if (progress && (done - last_reported) * 100 >= to_remove) {
-                last_reported = done;
-                if (!progress("simplify",
-                              to_remove ? static_cast<double>(done) / static_cast<double>(to_remove)
-                                        : 1.0))
-                    throw Cancelled();
+            while (!queue_.empty()) {
+                const Candidate c = queue_.top();
+                queue_.pop();
+                const std::size_t l = c.layer, v = c.vertex;
+                WorkLayer& w = layers_[l];
+                if (c.version != version_[l][v] || !removable(l, v) || w.alive_count <= w.target)
+                    continue;
+                const std::size_t a = w.prev[v], b = w.next[v];
+                if (params_.max_error > 0.0 && span_error(view(l), a, b) > params_.max_error) {
+                    w.locked[v] = 1;
+                    continue;
+                }
+                switch (try_remove(l, v)) {
+                    case Outcome::Removed:
+                        ++report_.removed;
+                        ++done;
+                        break;
+                    case Outcome::Deferred:
+                        ++report_.deferred;
+                        break;
+                    case Outcome::Refused:
+                        w.locked[v] = 1;
+                        ++report_.refused;
+                        ++report_.layers[l].refused;
+                        break;
+                }
+                if (progress && (done - last_reported) * 100 >= to_remove) {
+                    last_reported = done;
+                    if (!progress("simplify", to_remove ? static_cast<double>(done) /
+                                                              static_cast<double>(to_remove)
+                                                        : 1.0))
+                        throw Cancelled();
+                }
             }
         }
         if (progress && !progress("simplify", 1.0)) throw Cancelled();
@@ -407,7 +426,9 @@ class Driver {
         if (w.next[v] != kNone) grid_.insert(ref(l, v), seg_box(l, v));
     }
 
-    bool try_remove(std::size_t l, std::size_t v) {
+    enum class Outcome { Removed, Deferred, Refused };
+
+    Outcome try_remove(std::size_t l, std::size_t v) {
         WorkLayer& w = layers_[l];
         const std::size_t a = w.prev[v], b = w.next[v];
         const Vec2 removed = w.pos[v];
@@ -420,11 +441,11 @@ class Driver {
         if (clear) {
             push(l, a);
             push(l, b);
-            return true;
+            return Outcome::Removed;
         }
-        if (untangle_around(l, a, removed, b)) return true;
+        if (!defer_ && untangle_around(l, a, removed, b)) return Outcome::Removed;
         relink(l, v);
-        return false;
+        return defer_ ? Outcome::Deferred : Outcome::Refused;
     }
 
     // A run of alive vertices of one layer, in order, standing for one work layer.
@@ -434,52 +455,50 @@ class Driver {
         bool whole_loop = false;
     };
 
-    // Runs of layer k through its marked vertices, extended by n_out on both sides.
-    void runs_of(std::size_t k, std::vector<char>& mark, std::vector<Run>& out) const {
+    // Marks vertex v of layer k for the current untangling (stamp_ style, no clearing).
+    void mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked) {
+        if (mark_[k][v] == mark_counter_) return;
+        mark_[k][v] = mark_counter_;
+        marked.push_back(v);
+    }
+    bool is_marked(std::size_t k, std::size_t v) const {
+        return v != kNone && mark_[k][v] == mark_counter_;
+    }
+
+    // Runs of layer k through its `marked` vertices, extended by n_out on both sides, in the
+    // order of their first input id. Costs O(marked * n_out), whatever the layer's size.
+    void runs_of(std::size_t k, std::vector<std::size_t>& marked, std::vector<Run>& out) {
         const WorkLayer& w = layers_[k];
-        // Extend the marks by the collars.
-        std::vector<std::size_t> seeds;
-        for (std::size_t i = 0; i < mark.size(); ++i)
-            if (mark[i]) seeds.push_back(i);
-        for (std::size_t s : seeds) {
-            std::size_t i = s, j = s;
+        const std::size_t seeds = marked.size();
+        for (std::size_t s = 0; s < seeds; ++s) {
+            std::size_t i = marked[s], j = marked[s];
             for (std::size_t c = 0; c < params_.n_out; ++c) {
                 if (w.prev[i] != kNone) i = w.prev[i];
                 if (w.next[j] != kNone) j = w.next[j];
-                mark[i] = mark[j] = 1;
+                mark(k, i, marked);
+                mark(k, j, marked);
             }
         }
-        std::size_t start = w.first();
-        if (w.closed) {
-            std::size_t i = start, steps = 0;
-            while (mark[i] && steps <= w.alive_count) {
-                i = w.next[i];
-                ++steps;
-            }
-            if (steps > w.alive_count) {  // every vertex marked: the whole loop
-                Run run{k, {}, true};
-                std::size_t x = start;
-                do {
-                    run.ids.push_back(x);
-                    x = w.next[x];
-                } while (x != start);
-                out.push_back(std::move(run));
-                return;
-            }
-            start = i;  // an unmarked vertex: runs do not wrap past it
+        if (w.closed && marked.size() >= w.alive_count) {  // every vertex: the whole loop
+            Run run{k, {}, true};
+            const std::size_t start = *std::min_element(marked.begin(), marked.end());
+            std::size_t x = start;
+            do {
+                run.ids.push_back(x);
+                x = w.next[x];
+            } while (x != start);
+            out.push_back(std::move(run));
+            return;
         }
-        Run run{k, {}, false};
-        std::size_t i = start;
-        do {
-            if (mark[i]) {
-                run.ids.push_back(i);
-            } else if (!run.ids.empty()) {
-                out.push_back(std::move(run));
-                run = Run{k, {}, false};
-            }
-            i = w.next[i];
-        } while (i != kNone && i != start);
-        if (!run.ids.empty()) out.push_back(std::move(run));
+        std::vector<std::size_t> starts;
+        for (std::size_t v : marked)
+            if (!is_marked(k, w.prev[v])) starts.push_back(v);
+        std::sort(starts.begin(), starts.end());
+        for (std::size_t v : starts) {
+            Run run{k, {}, false};
+            for (std::size_t x = v; is_marked(k, x); x = w.next[x]) run.ids.push_back(x);
+            out.push_back(std::move(run));
+        }
     }
 
     bool untangle_around(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b) {
@@ -495,21 +514,21 @@ class Driver {
         const Box2 region = box.inflated(std::max(2.0 * nest_thickness_[l], 0.5 * chord));
         const Box2 around = region.inflated(std::max(2.0 * nest_thickness_[l], chord));
         // Work layers: runs through the vertices of the segments near the region.
-        std::vector<std::vector<char>> marks(layers_.size());
+        std::vector<std::vector<std::size_t>> marked(layers_.size());
+        ++mark_counter_;
         if (params_.global) {
-            for (std::size_t k = 0; k < layers_.size(); ++k) marks[k] = layers_[k].alive;
-        } else {
             for (std::size_t k = 0; k < layers_.size(); ++k)
-                marks[k].assign(layers_[k].alive.size(), 0);
+                for (std::size_t v = 0; v < layers_[k].alive.size(); ++v)
+                    if (layers_[k].alive[v]) mark(k, v, marked[k]);
+        } else {
             segments_near(around, [&](std::size_t k, std::size_t u) {
-                marks[k][u] = 1;
-                marks[k][layers_[k].next[u]] = 1;
+                mark(k, u, marked[k]);
+                mark(k, layers_[k].next[u], marked[k]);
             });
         }
         std::vector<Run> runs;
         for (std::size_t k = 0; k < layers_.size(); ++k)
-            if (std::find(marks[k].begin(), marks[k].end(), 1) != marks[k].end())
-                runs_of(k, marks[k], runs);
+            if (!marked[k].empty()) runs_of(k, marked[k], runs);
 
         std::vector<Layer> work_layers;
         std::vector<Piece> pieces;
@@ -517,6 +536,7 @@ class Driver {
         relations.scene = &input_;
         detail::EngineSettings settings = settings_;
         settings.outside_signs.clear();
+        settings.check_every_step = !params_.global;
         for (std::size_t r = 0; r < runs.size(); ++r) {
             const Run& run = runs[r];
             const Layer& parent = input_.layer(run.layer);
@@ -617,6 +637,9 @@ class Driver {
     std::vector<double> reach_, nest_thickness_;
     std::vector<std::vector<std::uint32_t>> stamp_, version_;
     std::uint32_t stamp_counter_ = 0;
+    std::vector<std::vector<std::uint32_t>> mark_;  // runs of the current untangling
+    std::uint32_t mark_counter_ = 0;
+    bool defer_ = false;  // this sweep sets conflicting removals aside
     std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
     detail::EngineSettings settings_;
     SimplifyReport report_;

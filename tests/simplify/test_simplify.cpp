@@ -101,6 +101,36 @@ TEST_CASE("generated stacks simplify without collisions, naive decimation collid
     }
 }
 
+TEST_CASE("both untangle schedules give collision-free results", "[simplify]") {
+    const Scene input = stack(5, 300, false);
+    SimplifyParams params;
+    params.decimator = "random";
+    params.remove = 0.95;
+    SECTION("deferred: conflicts wait, and the second sweep untangles what the targets need") {
+        Scene out = input;
+        const SimplifyReport r = simplify(out, params);
+        require_valid(input, out, r, params.untangling.separation_tolerance);
+        CHECK(r.deferred > 0);
+    }
+    SECTION("deferred, with a target only untangling reaches") {
+        params.keep = 6;
+        Scene out = input;
+        const SimplifyReport r = simplify(out, params);
+        require_valid(input, out, r, params.untangling.separation_tolerance);
+        CHECK(r.deferred > 0);
+        CHECK(r.untangle_calls > 0);
+        CHECK(r.untangle_calls > r.refused);  // some of them succeeded
+    }
+    SECTION("immediate: every conflict is untangled on the spot") {
+        params.schedule = UntangleSchedule::Immediate;
+        Scene out = input;
+        const SimplifyReport r = simplify(out, params);
+        require_valid(input, out, r, params.untangling.separation_tolerance);
+        CHECK(r.deferred == 0);
+        CHECK(r.untangle_calls > r.refused);
+    }
+}
+
 TEST_CASE("several seeds of random decimation", "[simplify]") {
     const Scene input = stack(5, 300, false);
     for (std::uint64_t seed : {1u, 2u, 5u}) {

@@ -14,6 +14,18 @@
 
 namespace strata {
 
+/// When simplify() untangles a removal that makes layers cross or come too close.
+enum class UntangleSchedule {
+    /// Set the removal aside and go on with the removals that need no untangling; the ones set
+    /// aside are tried again, untangling locally, only for layers that would otherwise miss
+    /// their target. The fast default: most conflicts never need untangling, because another
+    /// vertex of the same layer can go instead.
+    Deferred,
+    /// Untangle locally right after every removal that needs it (the paper's Algorithm 1: one
+    /// decimation, then one localized untangling).
+    Immediate,
+};
+
 /// Parameters of simplify(). Lengths are in scene units.
 struct SimplifyParams {
     /// "random" (the paper's experiments), "visvalingam" or "max-error"; see decimator.h.
@@ -29,14 +41,20 @@ struct SimplifyParams {
     bool untangle = true;    ///< false: naive decimation (the paper's left-hand images).
     bool global = false;     ///< Untangle the whole scene instead of a box (for comparison).
     std::size_t n_out = 7;   ///< N_out: fixed collar vertices on both sides of a piece.
-    /// Untangling settings. Defaults differ from untangle()'s: fewer rounds and passes, since
-    /// a step that does not untangle quickly is rolled back.
+    UntangleSchedule schedule = UntangleSchedule::Deferred;  ///< See UntangleSchedule.
+    /// Untangling settings. Defaults differ from untangle()'s: rounds of 10 projection steps,
+    /// one round per pass, 16 passes. Every pass rebuilds the fields from the current geometry
+    /// (cheap on the small local scenes), and within a pass each layer's own frozen field pulls
+    /// it back toward where the pass began; on generated 5/8-layer stacks this untangled 2.6x
+    /// more removals in 1/5 of the time of 2 passes of 8 rounds of 30 steps (closing note of
+    /// issue 5). A removal that does not untangle within them is rolled back.
     UntangleParams untangling = default_untangling();
 
     static UntangleParams default_untangling() {
         UntangleParams p;
-        p.max_rounds = 8;
-        p.max_passes = 2;
+        p.gradient_steps = 10;
+        p.max_rounds = 1;
+        p.max_passes = 16;
         p.field.backend = FieldBackend::ExactIndexed;
         return p;
     }
@@ -61,6 +79,7 @@ struct SimplifyReport {
     std::size_t removed = 0;         ///< Removals kept.
     std::size_t untangle_calls = 0;  ///< Local untanglings run.
     std::size_t refused = 0;         ///< Removals rolled back.
+    std::size_t deferred = 0;        ///< Removals set aside (UntangleSchedule::Deferred).
     int rounds = 0;                  ///< Untangling rounds over all calls.
     bool targets_met = true;         ///< Every layer reached its target.
     // Final exact check of the whole output (check_scene()).
@@ -84,8 +103,11 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params = {},
 /// `points` vertices each, thickness `thickness`, innermost first, one implicit stack. Where
 /// the folds bend the layers come close, and a decimation that cuts a fold's corner cuts into
 /// the neighbouring layer. Lengths in scene units.
+/// `spacing` 0 = automatic: 0.04, or less when the outermost offset would pass 80% of the
+/// curve's smallest radius of curvature (0.268), beyond which the outer layers loop over
+/// themselves (8 layers at 0.04 do): 0.04 up to 6 layers, 0.0306 for 8.
 Scene folded_stack(std::size_t layers, std::size_t points, double width = 10.0,
-                   double spacing = 0.04, double thickness = 0.01);
+                   double spacing = 0.0, double thickness = 0.01);
 
 /// The built-in demo (after the paper's Fig. 1): folded_stack(5, points), units "dm".
 Scene demo_scene(std::size_t points = 600);
