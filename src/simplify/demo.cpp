@@ -1,11 +1,18 @@
 #include "strata/simplify/simplify.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace strata {
 
 Scene folded_stack(std::size_t layers, std::size_t points, double width, double spacing,
                    double thickness) {
+    if (spacing <= 0.0) {
+        constexpr double kSmallestRadius = 0.268;  // of the folded curve (found numerically)
+        spacing = layers > 1
+                      ? std::min(0.04, 0.8 * kSmallestRadius / static_cast<double>(layers - 1))
+                      : 0.04;
+    }
     std::vector<Layer> out;
     for (std::size_t k = 0; k < layers; ++k) {
         Layer layer;
