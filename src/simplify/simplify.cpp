@@ -537,6 +537,7 @@ class Driver {
         detail::EngineSettings settings = settings_;
         settings.outside_signs.clear();
         settings.check_every_step = !params_.global;
+        settings.rest_at_start = true;  // passes of one round: match toward the start
         for (std::size_t r = 0; r < runs.size(); ++r) {
             const Run& run = runs[r];
             const Layer& parent = input_.layer(run.layer);

@@ -327,6 +327,17 @@ double finest_layer_median(const Scene& scene) {
     return std::isfinite(finest) ? finest : 0.0;
 }
 
+// The pieces' current vertex positions.
+std::vector<std::vector<Vec2>> shapes_of(const Scene& work, const std::vector<Piece>& pieces) {
+    std::vector<std::vector<Vec2>> shapes;
+    for (const Piece& piece : pieces) {
+        shapes.emplace_back();
+        for (std::size_t v : piece.vertices)
+            shapes.back().push_back(work.layer(piece.layer).points[v]);
+    }
+    return shapes;
+}
+
 }  // namespace
 
 EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params) {
@@ -357,12 +368,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     result.seconds_check += seconds_since(start);
     result.converged = result.ok;  // nothing to do is a converged run
     const int total_rounds = params.max_rounds * params.max_passes;
-    std::vector<std::vector<Vec2>> rest;  // the pieces' shapes before any move
-    for (const Piece& piece : pieces) {
-        rest.emplace_back();
-        for (std::size_t v : piece.vertices)
-            rest.back().push_back(work.layer(piece.layer).points[v]);
-    }
+    std::vector<std::vector<Vec2>> rest = shapes_of(work, pieces);  // shape matching's rest
     for (int pass = 0; pass < params.max_passes && !result.ok; ++pass) {
         ++result.passes;
         start = Clock::now();
@@ -376,10 +382,10 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         start = Clock::now();
         Pass engine(work, relations, fields, params, separation, settings.sample_spacing);
         result.converged = false;
+        if (!settings.rest_at_start) rest = shapes_of(work, pieces);
         for (int round = 0; round < params.max_rounds; ++round) {
-            // Shape matching toward the shape the engine started from, before every round
-            // but the very first: passes rebuild the fields, not the rest shape.
-            if ((pass > 0 || round > 0) && params.shape == ShapeMode::ShapeMatching)
+            const bool match = settings.rest_at_start ? pass > 0 || round > 0 : round > 0;
+            if (match && params.shape == ShapeMode::ShapeMatching)
                 engine.match_shapes(work, pieces, rest);
             // V (Eq. 7) of the round's last projection step: shape matching moves the
             // vertices at the start of every round, the projection must settle them again.

@@ -35,6 +35,11 @@ struct EngineSettings {
     /// Calls is_ok after every projection step rather than after every round: for callers
     /// whose check is local and cheap, a region stops as soon as it is good.
     bool check_every_step = false;
+    /// Shape matching pulls toward the shape the engine started from, before every round but
+    /// the very first, across passes. false: toward the shape at the start of each pass, from
+    /// its second round on (untangle(), whose passes are long: each pass settles from where
+    /// the previous one left the layers).
+    bool rest_at_start = false;
 };
 
 /// What run_engine() did.
