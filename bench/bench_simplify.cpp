@@ -12,11 +12,13 @@
 #include <sys/resource.h>
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 using namespace strata;
 
@@ -79,38 +81,76 @@ void paper() {
     }
 }
 
-void scenes(std::size_t max_points) {
-    std::printf("%-7s %-8s %-5s %-8s %9s %9s %8s %10s %8s %8s %6s %7s\n", "layers", "pts", "rm",
-                "backend", "naive s", "strata s", "ratio", "us/step", "refused", "untangl", "cross",
-                "rss MB");
+struct SceneFilter {
+    std::size_t min_points = 1000, max_points = 10000, layers = 0;  // 0: 5 and 8
+    double remove = 0.0;                                            // 0: 0.8, 0.9, 0.95
+    std::string backend;                                            // "": indexed and grid
+    std::string schedule;                                           // "": deferred and immediate
+};
+
+double max_hausdorff(const SimplifyReport& report) {
+    double h = 0.0;
+    for (const LayerSimplifyReport& layer : report.layers) h = std::max(h, layer.hausdorff);
+    return h;
+}
+
+void scenes(const SceneFilter& filter) {
+    // strata s and naive s: whole simplify() calls, final exact check and Hausdorff included;
+    // loop us/step: the removal loop alone (SimplifyReport::seconds_total) per kept removal.
+    std::printf("%-6s %-7s %-5s %-8s %-9s %8s %9s %7s %8s %8s %8s %8s %7s %5s %7s %9s %9s %6s\n",
+                "layers", "pts", "rm", "backend", "schedule", "naive s", "strata s", "ratio",
+                "us/step", "loop us", "deferred", "refused", "untangl", "cross", "gap/req",
+                "H naive", "H strata", "rss MB");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
-        for (std::size_t points = 1000; points <= max_points; points *= 10) {
+        for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
+            if (filter.layers != 0 && count != filter.layers) continue;
             const Scene input =
                 folded_stack(count, points, 10.0 * static_cast<double>(points) / 600.0);
-            for (double remove : {0.8, 0.9, 0.95}) {
+            if (!check_scene(input).is_collision_free()) {
+                std::fprintf(stderr,
+                             "strata_bench_simplify: the generated %zu x %zu input "
+                             "crosses itself\n",
+                             count, points);
+                std::exit(1);
+            }
+            const std::vector<double> removals = filter.remove > 0.0
+                                                     ? std::vector<double>{filter.remove}
+                                                     : std::vector<double>{0.8, 0.9, 0.95};
+            for (double remove : removals) {
                 SimplifyParams naive;
                 naive.decimator = "random";
                 naive.remove = remove;
                 naive.untangle = false;
                 Scene n = input;
                 double t = now();
-                simplify(n, naive);
+                const SimplifyReport rn = simplify(n, naive);
                 const double tn = now() - t;
-                for (FieldBackend backend : {FieldBackend::ExactIndexed, FieldBackend::Grid}) {
-                    SimplifyParams params = naive;
-                    params.untangle = true;
-                    params.untangling.field.backend = backend;
-                    Scene s = input;
-                    t = now();
-                    const SimplifyReport r = simplify(s, params);
-                    const double ts = now() - t;
-                    std::printf(
-                        "%-7zu %-8zu %-5.2f %-8s %9.3f %9.3f %8.1f %10.2f %8zu %8zu %6zu %7ld\n",
-                        count, points, remove, backend == FieldBackend::Grid ? "grid" : "indexed",
-                        tn, ts, ts / tn, 1e6 * ts / static_cast<double>(r.removed), r.refused,
-                        r.untangle_calls, r.crossings, peak_rss_mb());
-                    std::fflush(stdout);
-                }
+                for (FieldBackend backend : {FieldBackend::ExactIndexed, FieldBackend::Grid})
+                    for (UntangleSchedule schedule :
+                         {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                        const std::string name = backend == FieldBackend::Grid ? "grid" : "indexed";
+                        const std::string when =
+                            schedule == UntangleSchedule::Deferred ? "deferred" : "immediate";
+                        if (!filter.backend.empty() && name != filter.backend) continue;
+                        if (!filter.schedule.empty() && when != filter.schedule) continue;
+                        SimplifyParams params = naive;
+                        params.untangle = true;
+                        params.schedule = schedule;
+                        params.untangling.field.backend = backend;
+                        Scene s = input;
+                        t = now();
+                        const SimplifyReport r = simplify(s, params);
+                        const double ts = now() - t;
+                        std::printf(
+                            "%-6zu %-7zu %-5.2f %-8s %-9s %8.3f %9.3f %7.1f %8.2f %8.2f %8zu %8zu "
+                            "%7zu %5zu %7.3f %9.4f %9.4f %6ld\n",
+                            count, points, remove, name.c_str(), when.c_str(), tn, ts, ts / tn,
+                            1e6 * ts / static_cast<double>(r.removed),
+                            1e6 * r.seconds_total / static_cast<double>(r.removed), r.deferred,
+                            r.refused, r.untangle_calls, r.crossings, r.min_separation_ratio,
+                            max_hausdorff(rn), max_hausdorff(r), peak_rss_mb());
+                        std::fflush(stdout);
+                    }
             }
         }
 }
@@ -122,13 +162,32 @@ int main(int argc, char** argv) {
     if (what == "paper") {
         paper();
     } else if (what == "scenes") {
-        const std::size_t max = argc > 3 && std::string(argv[2]) == "--max"
-                                    ? std::strtoul(argv[3], nullptr, 10)
-                                    : 10000;
-        scenes(max);
+        SceneFilter filter;
+        for (int i = 2; i + 1 < argc; i += 2) {
+            const std::string key = argv[i], value = argv[i + 1];
+            if (key == "--min") {
+                filter.min_points = std::strtoul(value.c_str(), nullptr, 10);
+            } else if (key == "--max") {
+                filter.max_points = std::strtoul(value.c_str(), nullptr, 10);
+            } else if (key == "--layers") {
+                filter.layers = std::strtoul(value.c_str(), nullptr, 10);
+            } else if (key == "--remove") {
+                filter.remove = std::strtod(value.c_str(), nullptr);
+            } else if (key == "--schedule") {
+                filter.schedule = value;
+            } else if (key == "--backend") {
+                filter.backend = value;
+            } else {
+                std::fprintf(stderr, "strata_bench_simplify: unknown option %s\n", key.c_str());
+                return 2;
+            }
+        }
+        scenes(filter);
     } else {
         std::fprintf(stderr,
-                     "usage: strata_bench_simplify paper | scenes [--max POINTS_PER_LAYER]\n");
+                     "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
+                     "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
+                     "[--schedule deferred|immediate]\n");
         return 2;
     }
     return 0;
