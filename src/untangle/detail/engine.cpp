@@ -93,8 +93,7 @@ class Pass {
   public:
     Pass(const Scene& work, const RelationSource& relations, const SceneFields& fields,
          const UntangleParams& params, double min_separation, double sample_spacing)
-        : relations_(relations),
-          fields_(fields),
+        : fields_(fields),
           params_(params),
           min_separation_(min_separation),
           sample_spacing_(sample_spacing),
@@ -106,6 +105,26 @@ class Pass {
         reach_ = std::max(largest, min_separation) + 2.0 * sample_spacing;
         for (std::size_t j = 0; j < fields.size(); ++j)
             band_boxes_.push_back(work.layer(j).bounds().inflated(fields.params().band_width));
+        // Pairwise relations and separations once per pass, and whether the layers form one
+        // chain (every two of different parents nested, none side by side): then a point's
+        // members sorted by rank are a chain, composed without the general constraint search.
+        const std::size_t n = fields.size();
+        relation_.resize(n * n);
+        separation_.resize(n * n);
+        layer_weight_.resize(n);
+        rank_.assign(n, 0);
+        is_chain_ = true;
+        for (std::size_t a = 0; a < n; ++a) {
+            layer_weight_[a] = relations.weight(a);
+            for (std::size_t b = 0; b < n; ++b) {
+                if (a == b) continue;
+                const Relation r = relations.relation(a, b);
+                relation_[a * n + b] = r;
+                separation_[a * n + b] = std::max(relations.separation(a, b), min_separation);
+                if (r == Relation::Over) ++rank_[a];
+                if (r == Relation::SideBySide) is_chain_ = false;
+            }
+        }
     }
 
     Composed compose_at(std::size_t layer, const Vec2& x) {
@@ -119,7 +138,7 @@ class Pass {
         samples_[layer] = fields_.field(layer).sample(x);
         for (std::size_t j = 0; j < samples_.size(); ++j) {
             if (j == layer || !band_boxes_[j].contains(x)) continue;
-            samples_[j] = fields_.field(j).sample(x);
+            samples_[j] = fields_.field(j).sample_in_band(x);
             if (samples_[j].in_band && samples_[j].border > 0.0) members_.push_back(j);
         }
         Composed out;
@@ -129,13 +148,15 @@ class Pass {
             out.gradient = samples_[layer].gradient;
             return out;
         }
+        if (is_chain_ && compose_chain_at(layer, out)) return out;
+        const std::size_t n = fields_.size();
         for (std::size_t a = 0; a < members_.size(); ++a) {
             f_.push_back(samples_[members_[a]].value);
-            w_.push_back(relations_.weight(members_[a]));
+            w_.push_back(layer_weight_[members_[a]]);
             for (std::size_t b = a + 1; b < members_.size(); ++b) {
-                const double s =
-                    std::max(relations_.separation(members_[a], members_[b]), min_separation_);
-                switch (relations_.relation(members_[a], members_[b])) {
+                const std::size_t ab = members_[a] * n + members_[b];
+                const double s = separation_[ab];
+                switch (relation_[ab]) {
                     case Relation::Under:
                         constraints_.push_back({a, b, false, s});
                         break;
@@ -156,6 +177,33 @@ class Pass {
             out.gradient += r.coefficient(0, j) * samples_[members_[j]].gradient;
         out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
         return out;
+    }
+
+    // compose_at() for members of distinct ranks in a chain scene: sorted innermost first,
+    // composed by compose_chain(). Same result as the general path, whose chain detection
+    // finds this order and drops the implied constraints. false: two members share a rank
+    // (parts of one layer), left to the general path.
+    bool compose_chain_at(std::size_t layer, Composed& out) {
+        std::sort(members_.begin(), members_.end(),
+                  [this](std::size_t a, std::size_t b) { return rank_[a] < rank_[b]; });
+        for (std::size_t i = 0; i + 1 < members_.size(); ++i)
+            if (rank_[members_[i]] == rank_[members_[i + 1]]) return false;
+        const std::size_t n = fields_.size();
+        std::size_t own = 0;
+        separations_.clear();
+        for (std::size_t i = 0; i < members_.size(); ++i) {
+            if (members_[i] == layer) own = i;
+            f_.push_back(samples_[members_[i]].value);
+            w_.push_back(layer_weight_[members_[i]]);
+            if (i + 1 < members_.size())
+                separations_.push_back(separation_[members_[i] * n + members_[i + 1]]);
+        }
+        const CompositionResult& r = composer_.compose_chain(f_, w_, separations_);
+        out.fhat = r.fhat[own];
+        for (std::size_t j = 0; j < members_.size(); ++j)
+            out.gradient += r.coefficient(own, j) * samples_[members_[j]].gradient;
+        out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
+        return true;
     }
 
     // Parameters t in (0, 1) of the points tested on edge (a, b) of `layer`, in ts_: evenly
@@ -278,7 +326,6 @@ class Pass {
     }
 
   private:
-    const RelationSource& relations_;
     const SceneFields& fields_;
     const UntangleParams& params_;
     double min_separation_ = 0.0;
@@ -292,6 +339,12 @@ class Pass {
     std::vector<double> f_, w_;
     std::vector<std::size_t> members_;
     std::vector<CompositionConstraint> constraints_;
+    std::vector<double> separations_;   // compose_chain_at(): between consecutive members
+    std::vector<Relation> relation_;    // n x n, work layers
+    std::vector<double> separation_;    // n x n, max(required, min_separation)
+    std::vector<double> layer_weight_;  // per work layer
+    std::vector<std::size_t> rank_;     // layers each is over: innermost 0
+    bool is_chain_ = true;
     std::vector<Vec2> sum_, next_, current_;
     std::vector<double> weight_;
     std::vector<char> fixed_;
