@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 namespace strata::detail {
@@ -51,6 +52,20 @@ class ExactField final : public LayerField {
         }
         FieldSample out = store_.evaluate(x, best);
         out.in_band = std::sqrt(best.dist2) <= band_;
+        return out;
+    }
+
+    FieldSample sample_in_band(const Vec2& x) const override {
+        if (!indexed_) return sample(x);
+        Nearest best;
+        search(x, best, band_);
+        if (!best.found() || !(best.dist2 <= band_ * band_)) {
+            FieldSample out;
+            out.value = band_;
+            return out;
+        }
+        FieldSample out = store_.evaluate(x, best);
+        out.in_band = true;
         return out;
     }
 
@@ -120,8 +135,10 @@ class ExactField final : public LayerField {
         for (std::uint32_t s : it->second) store_.offer(x, s, best);
     }
     // Rings of cells around x's cell, clipped to the occupied cells, until no unvisited
-    // segment can be as near as the best one (ties included, so the winner is the brute one).
-    void search(const Vec2& x, Nearest& best) const {
+    // segment can be as near as the best one (ties included, so the winner is the brute one),
+    // or, when nothing within `limit` has been found, none can be within `limit` either.
+    void search(const Vec2& x, Nearest& best,
+                double limit = std::numeric_limits<double>::infinity()) const {
         if (imin_ > imax_) return;
         const long ci = cell_of(x.x), cj = cell_of(x.y);
         const long start = std::max({imin_ - ci, ci - imax_, jmin_ - cj, cj - jmax_, 0L});
@@ -145,6 +162,7 @@ class ExactField final : public LayerField {
             const double hi_y = static_cast<double>(cj + r + 1) * cell_;
             const double margin = std::min({x.x - lo_x, hi_x - x.x, x.y - lo_y, hi_y - x.y});
             if (best.found() && margin > 0.0 && best.dist2 < margin * margin) return;
+            if (margin > limit && !(best.dist2 <= limit * limit)) return;
         }
     }
 

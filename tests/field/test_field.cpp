@@ -236,6 +236,7 @@ TEST_CASE("closed layers are negative inside for both windings", "[field]") {
 }
 
 TEST_CASE("exact brute force and indexed backends agree exactly", "[field]") {
+    // sample_in_band() is checked against sample() here too.
     std::mt19937 rng(11);
     std::vector<Layer> layers;
     for (int k = 0; k < 3; ++k) {
@@ -250,18 +251,33 @@ TEST_CASE("exact brute force and indexed backends agree exactly", "[field]") {
             p.bucket_size = cell;
             const auto brute = make_field(layer, 1, with_backend(p, FieldBackend::ExactBrute));
             const auto indexed = make_field(layer, 1, with_backend(p, FieldBackend::ExactIndexed));
-            std::size_t differ = 0;
+            std::size_t differ = 0, differ_in_band = 0, in_band = 0;
             for (int q = 0; q < 2000; ++q) {
                 Vec2 x(u(rng), u(rng));
                 if (q % 3 == 0) x = layer.points[static_cast<std::size_t>(q) % layer.points.size()];
                 if (q % 3 == 1) x = 0.5 * (layer.points[0] + layer.points[1]);  // exact ties
                 if (q == 5) x = Vec2(1e6, -1e6);
+                if (q % 7 == 6)  // near the curve: in and just out of the band (0.05)
+                    x = layer.points[static_cast<std::size_t>(q) % layer.points.size()] +
+                        Vec2(0.07 * u(rng) / 5.0, 0.07 * u(rng) / 5.0);
                 const FieldSample a = brute->sample(x), b = indexed->sample(x);
                 if (a.value != b.value || a.gradient != b.gradient || a.in_band != b.in_band ||
                     a.border != b.border)
                     ++differ;
+                // sample_in_band(): the same answer in the band, "out of band" outside it.
+                for (const auto* field : {brute.get(), indexed.get()}) {
+                    const FieldSample c = field->sample_in_band(x);
+                    if (c.in_band != a.in_band) ++differ_in_band;
+                    if (c.in_band &&
+                        (c.value != a.value || c.gradient != a.gradient || c.border != a.border))
+                        ++differ_in_band;
+                    in_band += c.in_band ? 1 : 0;
+                }
             }
             CHECK(differ == 0);
+            CHECK(differ_in_band == 0);
+            CHECK(in_band > 400);  // both branches of sample_in_band() were taken
+            CHECK(in_band < 2 * 2000 - 400);
         }
     }
 }

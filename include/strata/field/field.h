@@ -115,6 +115,11 @@ class LayerField {
     /// Value, gradient, band membership and border field at `x` (scene units).
     virtual FieldSample sample(const Vec2& x) const = 0;
 
+    /// sample(x) when `x` is in the band; otherwise only `in_band` (false) is meaningful, the
+    /// other members are unspecified. The composition needs nothing more from a layer that is
+    /// out of band, and the exact indexed backend then stops searching at the band's edge.
+    virtual FieldSample sample_in_band(const Vec2& x) const { return sample(x); }
+
     /// Follows a local edit of the polyline: `points` is the whole new polyline, `edit` says
     /// which vertices changed. Only the part of the field near the edit is recomputed; the
     /// result equals a field built from scratch on `points`.
