@@ -189,7 +189,8 @@ Run add_check_command(CLI::App& app) {
                                        "nesting (exit 0 ok, 1 not, 2 bad input)");
     cmd->add_option("input", opt->input, "Scene file (.json or .svg)")->required();
     cmd->add_option("--reference", opt->reference,
-                    "Original scene: adds per-layer Hausdorff distances");
+                    "Original scene: adds per-layer Hausdorff distances, and gives each open "
+                    "layer the outside side it has there (as simplify's own check does)");
     cmd->add_flag("--json", opt->json, "Print the report as JSON");
     cmd->add_flag("--strict", opt->strict, "Separation shortfalls make the exit code 1");
     cmd->add_option("--near", opt->params.near_distance,
@@ -206,14 +207,25 @@ Run add_check_command(CLI::App& app) {
         const Scene scene = read_scene(opt->input);
         for (const std::string& note : scene.diagnostics().notes)
             std::cerr << "strata: note: " << opt->input << ": " << note << '\n';
-        const CheckReport report = check_scene(scene, opt->params);
-        std::vector<std::optional<HausdorffDistance>> h;
+        std::optional<Scene> reference;
+        CheckParams params = opt->params;
         if (!opt->reference.empty()) {
-            const Scene reference = read_scene(opt->reference);
+            reference = read_scene(opt->reference);
+            // An open layer simplified to a few vertices gets its side from its original.
+            for (std::size_t i = 0; i < scene.size(); ++i) {
+                const auto j = reference->find(scene.layer(i).name);
+                params.outside_sides.push_back(j && !reference->layer(*j).closed
+                                                   ? outside_side(*reference, *j)
+                                                   : outside_side(scene, i));
+            }
+        }
+        const CheckReport report = check_scene(scene, params);
+        std::vector<std::optional<HausdorffDistance>> h;
+        if (reference) {
             Box2 box = scene.bounds();
-            box.extend(reference.bounds());
+            box.extend(reference->bounds());
             const double diagonal = std::hypot(box.size().x, box.size().y);
-            h = hausdorff_to(scene, reference,
+            h = hausdorff_to(scene, *reference,
                              opt->hausdorff_tolerance * std::max(diagonal, 1e-300));
         }
         const bool ok = report.is_collision_free() && (!opt->strict || report.separations_hold());

@@ -469,7 +469,10 @@ class Checker {
         const double near = report_.near_distance;
         std::vector<int> outside(n_, 0);
         for (std::size_t b = 0; b < n_; ++b)
-            if (!scene_.layer(b).closed) outside[b] = open_outside(scene_, b, indices_[b], near);
+            if (!scene_.layer(b).closed)
+                outside[b] = params_.outside_sides.empty()
+                                 ? open_outside(scene_, b, indices_[b], near)
+                                 : params_.outside_sides[b];
         for (std::size_t a = 0; a < n_; ++a)
             for (std::size_t b = 0; b < n_; ++b) {
                 if (a == b) continue;
@@ -616,6 +619,15 @@ double automatic_near_distance(const Scene& scene) {
 
 CheckReport check_scene(const Scene& scene, const CheckParams& params) {
     validate(params);
+    if (!params.outside_sides.empty() && params.outside_sides.size() != scene.size())
+        throw InvalidInput("check: params.outside_sides has " +
+                           std::to_string(params.outside_sides.size()) + " entries for " +
+                           std::to_string(scene.size()) + " layers");
+    for (std::size_t i = 0; i < params.outside_sides.size(); ++i)
+        if (!scene.layer(i).closed && params.outside_sides[i] != 1 && params.outside_sides[i] != -1)
+            throw InvalidInput("check: params.outside_sides[" + std::to_string(i) + "] (layer '" +
+                               scene.layer(i).name + "') must be +1 or -1 (got " +
+                               std::to_string(params.outside_sides[i]) + ")");
     return Checker(scene, params).run();
 }
 

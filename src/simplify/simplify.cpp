@@ -668,6 +668,10 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     auto start = Clock::now();
     CheckParams check_params;
     check_params.separation_tolerance = params.untangling.separation_tolerance;
+    // The input's open-layer sides: vertex order is kept, and the vote of outside_side() is
+    // unreliable on layers simplified to a few vertices.
+    for (std::size_t l = 0; l < scene.size(); ++l)
+        check_params.outside_sides.push_back(outside_side(scene, l));
     const CheckReport check = check_scene(out, check_params);
     report.crossings = check.crossing_count;
     report.self_crossings = check.total_self_crossings();

@@ -318,6 +318,24 @@ TEST_CASE("nesting against open layers uses their outside side", "[checks]") {
         }
         CHECK_FALSE(report.is_collision_free());
     }
+    SECTION("outside sides given by the caller replace the vote") {
+        const Scene scene = test::stacked_sines(3, 100, 0.3, 0.5);
+        CheckParams params;
+        params.outside_sides = {outside_side(scene, 0), outside_side(scene, 1),
+                                outside_side(scene, 2)};
+        CHECK(check_scene(scene, params).is_collision_free());
+        params.outside_sides[1] = -params.outside_sides[1];  // sine_1 upside down
+        const CheckReport flipped = check_scene(scene, params);
+        CHECK(flipped.crossing_count == 0);
+        CHECK(flipped.nesting_violation_count > 0);
+        for (const NestingViolation& v : flipped.nesting_violations) CHECK(v.other == 1);
+        params.outside_sides = {1, 1};
+        CHECK_THROWS_WITH(check_scene(scene, params),
+                          Catch::Contains("outside_sides has 2 entries for 3 layers"));
+        params.outside_sides = {1, 0, 1};
+        CHECK_THROWS_WITH(check_scene(scene, params),
+                          Catch::Contains("outside_sides[1] (layer 'sine_1') must be +1 or -1"));
+    }
 }
 
 TEST_CASE("self-crossings", "[checks]") {

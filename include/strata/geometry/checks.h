@@ -21,6 +21,11 @@ struct CheckParams {
     double separation_tolerance = 0.0;
     /// Cap on the locations and vertices listed in the report (counts are never capped). >= 0.
     std::size_t max_listed = 1000;
+    /// Outside sides of the open layers (+1 or -1 per layer, see outside_side(); entries of
+    /// closed layers are ignored), e.g. those of the input a simplified scene came from: the
+    /// vote of outside_side() is unreliable on an open layer simplified to 2 or 3 vertices.
+    /// Empty: outside_side() of `scene` itself.
+    std::vector<int> outside_sides;
 };
 
 /// Throws InvalidInput naming the first out-of-range field.
