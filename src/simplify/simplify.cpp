@@ -176,7 +176,6 @@ class Driver {
         version_.resize(n);
         for (std::size_t l = 0; l < n; ++l) version_[l].assign(layers_[l].alive.size(), 0);
         if (params.untangle) settings_ = detail::resolve_settings(scene, params.untangling);
-
         report_.layers.resize(n);
     }
 

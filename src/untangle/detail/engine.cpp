@@ -148,7 +148,8 @@ class Pass {
             out.gradient = samples_[layer].gradient;
             return out;
         }
-        if (is_chain_ && compose_chain_at(layer, out)) return out;
+        if (is_chain_ && params_.composition.use_chain_fast_path && compose_chain_at(layer, out))
+            return out;
         const std::size_t n = fields_.size();
         for (std::size_t a = 0; a < members_.size(); ++a) {
             f_.push_back(samples_[members_[a]].value);
@@ -184,24 +185,25 @@ class Pass {
     // finds this order and drops the implied constraints. false: two members share a rank
     // (parts of one layer), left to the general path.
     bool compose_chain_at(std::size_t layer, Composed& out) {
-        std::sort(members_.begin(), members_.end(),
+        chain_ = members_;  // members_ keeps `layer` first for the general path
+        std::sort(chain_.begin(), chain_.end(),
                   [this](std::size_t a, std::size_t b) { return rank_[a] < rank_[b]; });
-        for (std::size_t i = 0; i + 1 < members_.size(); ++i)
-            if (rank_[members_[i]] == rank_[members_[i + 1]]) return false;
+        for (std::size_t i = 0; i + 1 < chain_.size(); ++i)
+            if (rank_[chain_[i]] == rank_[chain_[i + 1]]) return false;
         const std::size_t n = fields_.size();
         std::size_t own = 0;
         separations_.clear();
-        for (std::size_t i = 0; i < members_.size(); ++i) {
-            if (members_[i] == layer) own = i;
-            f_.push_back(samples_[members_[i]].value);
-            w_.push_back(layer_weight_[members_[i]]);
-            if (i + 1 < members_.size())
-                separations_.push_back(separation_[members_[i] * n + members_[i + 1]]);
+        for (std::size_t i = 0; i < chain_.size(); ++i) {
+            if (chain_[i] == layer) own = i;
+            f_.push_back(samples_[chain_[i]].value);
+            w_.push_back(layer_weight_[chain_[i]]);
+            if (i + 1 < chain_.size())
+                separations_.push_back(separation_[chain_[i] * n + chain_[i + 1]]);
         }
         const CompositionResult& r = composer_.compose_chain(f_, w_, separations_);
         out.fhat = r.fhat[own];
-        for (std::size_t j = 0; j < members_.size(); ++j)
-            out.gradient += r.coefficient(own, j) * samples_[members_[j]].gradient;
+        for (std::size_t j = 0; j < chain_.size(); ++j)
+            out.gradient += r.coefficient(own, j) * samples_[chain_[j]].gradient;
         out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
         return true;
     }
@@ -339,6 +341,7 @@ class Pass {
     std::vector<double> f_, w_;
     std::vector<std::size_t> members_;
     std::vector<CompositionConstraint> constraints_;
+    std::vector<std::size_t> chain_;    // compose_chain_at(): members innermost first
     std::vector<double> separations_;   // compose_chain_at(): between consecutive members
     std::vector<Relation> relation_;    // n x n, work layers
     std::vector<double> separation_;    // n x n, max(required, min_separation)
