@@ -145,22 +145,33 @@ TEST_CASE("several seeds of random decimation", "[simplify]") {
 }
 
 TEST_CASE("the result is the same at 1 and 2 threads", "[simplify]") {
+    // The untangling's projection steps run in parallel (TBB); the immediate schedule makes
+    // sure there is untangling to do.
     const Scene input = stack(5, 300, false);
     for (FieldBackend backend : {FieldBackend::Grid, FieldBackend::ExactIndexed}) {
-        SimplifyParams params;
-        params.decimator = "random";
-        params.untangling.field.backend = backend;
-        Scene one = input, two = input;
-        {
-            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-            simplify(one, params);
+        for (UntangleSchedule schedule :
+             {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+            SimplifyParams params;
+            params.decimator = "random";
+            params.remove = 0.95;
+            params.schedule = schedule;
+            params.untangling.field.backend = backend;
+            Scene one = input, two = input;
+            SimplifyReport r1, r2;
+            {
+                tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+                r1 = simplify(one, params);
+            }
+            {
+                tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+                r2 = simplify(two, params);
+            }
+            if (schedule == UntangleSchedule::Immediate) CHECK(r1.untangle_calls > 10);
+            CHECK(r1.untangle_calls == r2.untangle_calls);
+            CHECK(r1.rounds == r2.rounds);
+            for (std::size_t l = 0; l < one.size(); ++l)
+                CHECK(one.layer(l).points == two.layer(l).points);
         }
-        {
-            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-            simplify(two, params);
-        }
-        for (std::size_t l = 0; l < one.size(); ++l)
-            CHECK(one.layer(l).points == two.layer(l).points);
     }
 }
 

@@ -5,6 +5,7 @@
 #include "support/fixtures.h"
 #include "support/require.h"
 
+#include <tbb/global_control.h>
 #include <catch2/catch.hpp>
 #include <glm/geometric.hpp>
 
@@ -83,6 +84,27 @@ TEST_CASE("stacked open layers keep order and separation", "[untangle]") {
     const UntangleReport report = untangle(scene, exact_params());
     CHECK(report.collision_free);
     test::require_collision_free(scene, 0.1);
+}
+
+TEST_CASE("untangling gives the same result at 1 and 2 threads", "[untangle]") {
+    // The projection steps run in parallel; sums are gathered in a fixed order.
+    const Scene stack = test::stacked_sines(5, 120, 0.3, 0.25, 0.1);
+    std::vector<Layer> layers = stack.layers();
+    for (Vec2& p : layers[2].points)
+        if (p.x > 4.0 && p.x < 7.0) p.y -= 0.6 * std::sin((p.x - 4.0) * kPi / 3.0);
+    Scene one(layers), two(layers);
+    UntangleReport r1, r2;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        r1 = untangle(one, exact_params());
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        r2 = untangle(two, exact_params());
+    }
+    CHECK(r1.collision_free);
+    CHECK(r1.rounds == r2.rounds);
+    for (std::size_t l = 0; l < one.size(); ++l) CHECK(one.layer(l).points == two.layer(l).points);
 }
 
 TEST_CASE("two loops side by side inside a third stay apart and inside", "[untangle]") {

@@ -4,6 +4,9 @@
 #include "strata/geometry/checks.h"
 #include "strata/untangle/shape_matching.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -88,6 +91,16 @@ struct Composed {
     bool is_violated = false;  // the composition changed this layer's value
 };
 
+// Scratch buffers of one composition, one set per thread.
+struct Scratch {
+    explicit Scratch(const CompositionParams& params) : composer(params) {}
+    Composer composer;
+    std::vector<FieldSample> samples;
+    std::vector<double> f, w, separations, ts;
+    std::vector<std::size_t> members, chain;
+    std::vector<CompositionConstraint> constraints;
+};
+
 // One pass of projection + shape matching over fixed fields.
 class Pass {
   public:
@@ -97,7 +110,7 @@ class Pass {
           params_(params),
           min_separation_(min_separation),
           sample_spacing_(sample_spacing),
-          composer_(params.composition) {
+          scratch_([&params] { return Scratch(params.composition); }) {
         double largest = 0.0;
         for (std::size_t a = 0; a < fields.size(); ++a)
             for (std::size_t b = a + 1; b < fields.size(); ++b)
@@ -127,55 +140,56 @@ class Pass {
         }
     }
 
-    Composed compose_at(std::size_t layer, const Vec2& x) {
+    // The composed value and gradient of `layer` at x (thread-safe with one Scratch per thread).
+    Composed compose_at(std::size_t layer, const Vec2& x, Scratch& s) const {
         // Only layers whose band box holds x can take part: the others are not sampled.
-        samples_.resize(fields_.size());
-        f_.clear();
-        w_.clear();
-        members_.clear();
-        constraints_.clear();
-        members_.push_back(layer);
-        samples_[layer] = fields_.field(layer).sample(x);
-        for (std::size_t j = 0; j < samples_.size(); ++j) {
+        s.samples.resize(fields_.size());
+        s.f.clear();
+        s.w.clear();
+        s.members.clear();
+        s.constraints.clear();
+        s.members.push_back(layer);
+        s.samples[layer] = fields_.field(layer).sample(x);
+        for (std::size_t j = 0; j < s.samples.size(); ++j) {
             if (j == layer || !band_boxes_[j].contains(x)) continue;
-            samples_[j] = fields_.field(j).sample_in_band(x);
-            if (samples_[j].in_band && samples_[j].border > 0.0) members_.push_back(j);
+            s.samples[j] = fields_.field(j).sample_in_band(x);
+            if (s.samples[j].in_band && s.samples[j].border > 0.0) s.members.push_back(j);
         }
         Composed out;
-        out.f = samples_[layer].value;
-        if (members_.size() == 1) {
+        out.f = s.samples[layer].value;
+        if (s.members.size() == 1) {
             out.fhat = out.f;
-            out.gradient = samples_[layer].gradient;
+            out.gradient = s.samples[layer].gradient;
             return out;
         }
-        if (is_chain_ && params_.composition.use_chain_fast_path && compose_chain_at(layer, out))
+        if (is_chain_ && params_.composition.use_chain_fast_path && compose_chain_at(layer, s, out))
             return out;
         const std::size_t n = fields_.size();
-        for (std::size_t a = 0; a < members_.size(); ++a) {
-            f_.push_back(samples_[members_[a]].value);
-            w_.push_back(layer_weight_[members_[a]]);
-            for (std::size_t b = a + 1; b < members_.size(); ++b) {
-                const std::size_t ab = members_[a] * n + members_[b];
-                const double s = separation_[ab];
+        for (std::size_t a = 0; a < s.members.size(); ++a) {
+            s.f.push_back(s.samples[s.members[a]].value);
+            s.w.push_back(layer_weight_[s.members[a]]);
+            for (std::size_t b = a + 1; b < s.members.size(); ++b) {
+                const std::size_t ab = s.members[a] * n + s.members[b];
+                const double sep = separation_[ab];
                 switch (relation_[ab]) {
                     case Relation::Under:
-                        constraints_.push_back({a, b, false, s});
+                        s.constraints.push_back({a, b, false, sep});
                         break;
                     case Relation::Over:
-                        constraints_.push_back({b, a, false, s});
+                        s.constraints.push_back({b, a, false, sep});
                         break;
                     case Relation::SideBySide:
-                        constraints_.push_back({a, b, true, s});
+                        s.constraints.push_back({a, b, true, sep});
                         break;
                     case Relation::Same:
                         break;
                 }
             }
         }
-        const CompositionResult& r = composer_.compose(f_, w_, constraints_);
+        const CompositionResult& r = s.composer.compose(s.f, s.w, s.constraints);
         out.fhat = r.fhat[0];
-        for (std::size_t j = 0; j < members_.size(); ++j)
-            out.gradient += r.coefficient(0, j) * samples_[members_[j]].gradient;
+        for (std::size_t j = 0; j < s.members.size(); ++j)
+            out.gradient += r.coefficient(0, j) * s.samples[s.members[j]].gradient;
         out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
         return out;
     }
@@ -184,54 +198,55 @@ class Pass {
     // composed by compose_chain(). Same result as the general path, whose chain detection
     // finds this order and drops the implied constraints. false: two members share a rank
     // (parts of one layer), left to the general path.
-    bool compose_chain_at(std::size_t layer, Composed& out) {
-        chain_ = members_;  // members_ keeps `layer` first for the general path
-        std::sort(chain_.begin(), chain_.end(),
+    bool compose_chain_at(std::size_t layer, Scratch& s, Composed& out) const {
+        s.chain = s.members;  // members keeps `layer` first for the general path
+        std::sort(s.chain.begin(), s.chain.end(),
                   [this](std::size_t a, std::size_t b) { return rank_[a] < rank_[b]; });
-        for (std::size_t i = 0; i + 1 < chain_.size(); ++i)
-            if (rank_[chain_[i]] == rank_[chain_[i + 1]]) return false;
+        for (std::size_t i = 0; i + 1 < s.chain.size(); ++i)
+            if (rank_[s.chain[i]] == rank_[s.chain[i + 1]]) return false;
         const std::size_t n = fields_.size();
         std::size_t own = 0;
-        separations_.clear();
-        for (std::size_t i = 0; i < chain_.size(); ++i) {
-            if (chain_[i] == layer) own = i;
-            f_.push_back(samples_[chain_[i]].value);
-            w_.push_back(layer_weight_[chain_[i]]);
-            if (i + 1 < chain_.size())
-                separations_.push_back(separation_[chain_[i] * n + chain_[i + 1]]);
+        s.separations.clear();
+        for (std::size_t i = 0; i < s.chain.size(); ++i) {
+            if (s.chain[i] == layer) own = i;
+            s.f.push_back(s.samples[s.chain[i]].value);
+            s.w.push_back(layer_weight_[s.chain[i]]);
+            if (i + 1 < s.chain.size())
+                s.separations.push_back(separation_[s.chain[i] * n + s.chain[i + 1]]);
         }
-        const CompositionResult& r = composer_.compose_chain(f_, w_, separations_);
+        const CompositionResult& r = s.composer.compose_chain(s.f, s.w, s.separations);
         out.fhat = r.fhat[own];
-        for (std::size_t j = 0; j < chain_.size(); ++j)
-            out.gradient += r.coefficient(own, j) * samples_[chain_[j]].gradient;
+        for (std::size_t j = 0; j < s.chain.size(); ++j)
+            out.gradient += r.coefficient(own, j) * s.samples[s.chain[j]].gradient;
         out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
         return true;
     }
 
-    // Parameters t in (0, 1) of the points tested on edge (a, b) of `layer`, in ts_: evenly
+    // Parameters t in (0, 1) of the points tested on edge (a, b) of `layer`, in `ts`: evenly
     // spaced ones, and the feet of the nearby vertices of the other layers.
-    void edge_samples(const Scene& scene, std::size_t layer, const Vec2& a, const Vec2& b) {
-        ts_.clear();
+    void edge_samples(const Scene& scene, std::size_t layer, const Vec2& a, const Vec2& b,
+                      std::vector<double>& ts) const {
+        ts.clear();
         const double length = glm::distance(a, b);
         int count = params_.edge_samples;
         if (sample_spacing_ > 0.0)
             count =
                 std::max(count, static_cast<int>(std::min(64.0, length / (4.0 * sample_spacing_))));
-        for (int s = 1; s <= count; ++s) ts_.push_back(static_cast<double>(s) / (count + 1.0));
+        for (int s = 1; s <= count; ++s) ts.push_back(static_cast<double>(s) / (count + 1.0));
         if (sample_spacing_ <= 0.0 || !(length > 0.0)) return;
         const Vec2 dir = (b - a) / length;
         const double reach = std::min(reach_, 0.5 * length);
         Box2 box;
         box.extend(a);
         box.extend(b);
-        const std::size_t regular = ts_.size();
+        const std::size_t regular = ts.size();
         grid_.query(box.inflated(reach), [&](std::size_t other, std::size_t vertex) {
-            if (other == layer || ts_.size() >= regular + 64) return;
+            if (other == layer || ts.size() >= regular + 64) return;
             const Vec2 w = scene.layer(other).points[vertex];
             const double along = glm::dot(w - a, dir);
             if (along <= 0.0 || along >= length) return;
             const double across = std::abs(dir.x * (w.y - a.y) - dir.y * (w.x - a.x));
-            if (across <= reach) ts_.push_back(along / length);
+            if (across <= reach) ts.push_back(along / length);
         });
     }
 
@@ -253,34 +268,83 @@ class Pass {
                     region.extend(scene.layer(piece.layer).points[v]);
             grid_.build(scene, region.inflated(reach_), sample_spacing_);
         }
+        // Every free vertex and every edge (between consecutive piece vertices, sampled when
+        // one end is free) of every piece is one task, writing only its own slots; all read the
+        // positions at the start of the step (Jacobi). Tasks run in parallel; the sums are
+        // gathered in a fixed order, so the step does not depend on the number of threads.
+        vertex_offset_.assign(1, 0);
+        edge_offset_.assign(1, 0);
         for (const Piece& piece : pieces) {
+            const std::size_t m = piece.vertices.size();
+            vertex_offset_.push_back(vertex_offset_.back() + m);
+            edge_offset_.push_back(edge_offset_.back() + (m == 0                ? 0
+                                                          : piece.is_whole_loop ? m
+                                                                                : m - 1));
+        }
+        const std::size_t vertices = vertex_offset_.back(), edges = edge_offset_.back();
+        own_.assign(vertices, Vec2(0.0));
+        edge_a_.assign(edges, Vec2(0.0));
+        edge_b_.assign(edges, Vec2(0.0));
+        edge_wa_.assign(edges, 0.0);
+        edge_wb_.assign(edges, 0.0);
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, vertices + edges, 4),
+            [&](const tbb::blocked_range<std::size_t>& range) {
+                Scratch& s = scratch_.local();
+                for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                    const bool is_vertex = i < vertices;
+                    const std::vector<std::size_t>& offset =
+                        is_vertex ? vertex_offset_ : edge_offset_;
+                    const std::size_t index = is_vertex ? i : i - vertices;
+                    const std::size_t p = static_cast<std::size_t>(
+                        std::upper_bound(offset.begin(), offset.end(), index) - offset.begin() - 1);
+                    const Piece& piece = pieces[p];
+                    const std::vector<Vec2>& x = scene.layer(piece.layer).points;
+                    const std::size_t k = index - offset[p];
+                    if (is_vertex) {
+                        if (piece.is_free[k])
+                            own_[i] =
+                                step_toward_zero(compose_at(piece.layer, x[piece.vertices[k]], s));
+                        continue;
+                    }
+                    const std::size_t k2 = (k + 1) % piece.vertices.size();
+                    if (!piece.is_free[k] && !piece.is_free[k2]) continue;
+                    const Vec2 a = x[piece.vertices[k]], b = x[piece.vertices[k2]];
+                    edge_samples(scene, piece.layer, a, b, s.ts);
+                    for (double t : s.ts) {
+                        const Composed c = compose_at(piece.layer, a + t * (b - a), s);
+                        if (!c.is_violated) continue;
+                        const Vec2 d = step_toward_zero(c);
+                        edge_a_[index] += (1.0 - t) * d;
+                        edge_wa_[index] += 1.0 - t;
+                        edge_b_[index] += t * d;
+                        edge_wb_[index] += t;
+                    }
+                }
+            });
+        for (std::size_t p = 0; p < pieces.size(); ++p) {
+            const Piece& piece = pieces[p];
             const Layer& layer = scene.layer(piece.layer);
             const std::vector<Vec2>& x = layer.points;
             const std::size_t n = x.size();
             const std::size_t m = piece.vertices.size();
+            const std::size_t piece_edges = edge_offset_[p + 1] - edge_offset_[p];
+            const Vec2* own = own_.data() + vertex_offset_[p];
+            const std::size_t e0 = edge_offset_[p];
             sum_.assign(m, Vec2(0.0));
             weight_.assign(m, 0.0);
             for (std::size_t k = 0; k < m; ++k) {
                 if (!piece.is_free[k]) continue;
-                const Composed c = compose_at(piece.layer, x[piece.vertices[k]]);
-                sum_[k] += step_toward_zero(c);
-                weight_[k] += 1.0;
-            }
-            // Edges between consecutive piece vertices with a free end.
-            const std::size_t edges = piece.is_whole_loop ? m : m - 1;
-            for (std::size_t k = 0; k < edges; ++k) {
-                const std::size_t k2 = (k + 1) % m;
-                if (!piece.is_free[k] && !piece.is_free[k2]) continue;
-                const Vec2 a = x[piece.vertices[k]], b = x[piece.vertices[k2]];
-                edge_samples(scene, piece.layer, a, b);
-                for (double t : ts_) {
-                    const Composed c = compose_at(piece.layer, a + t * (b - a));
-                    if (!c.is_violated) continue;
-                    const Vec2 d = step_toward_zero(c);
-                    sum_[k] += (1.0 - t) * d;
-                    weight_[k] += 1.0 - t;
-                    sum_[k2] += t * d;
-                    weight_[k2] += t;
+                sum_[k] = own[k];
+                weight_[k] = 1.0;
+                if (k > 0 || piece.is_whole_loop) {  // the edge ending at k
+                    const std::size_t e = e0 + (k > 0 ? k - 1 : piece_edges - 1);
+                    sum_[k] += edge_b_[e];
+                    weight_[k] += edge_wb_[e];
+                }
+                if (k < piece_edges) {  // the edge starting at k
+                    sum_[k] += edge_a_[e0 + k];
+                    weight_[k] += edge_wa_[e0 + k];
                 }
             }
             next_ = x;
@@ -333,16 +397,13 @@ class Pass {
     double min_separation_ = 0.0;
     double sample_spacing_ = 0.0;
     double reach_ = 0.0;  // how far from an edge a vertex of another layer gets its own sample
-    Composer composer_;
+    tbb::enumerable_thread_specific<Scratch> scratch_;
     VertexGrid grid_;
     std::vector<Box2> band_boxes_;  // each layer's bounds grown by the band width
-    std::vector<double> ts_;
-    std::vector<FieldSample> samples_;
-    std::vector<double> f_, w_;
-    std::vector<std::size_t> members_;
-    std::vector<CompositionConstraint> constraints_;
-    std::vector<std::size_t> chain_;    // compose_chain_at(): members innermost first
-    std::vector<double> separations_;   // compose_chain_at(): between consecutive members
+    // project(): per vertex and per edge of all pieces, and where each piece's start.
+    std::vector<Vec2> own_, edge_a_, edge_b_;
+    std::vector<double> edge_wa_, edge_wb_;
+    std::vector<std::size_t> vertex_offset_, edge_offset_;
     std::vector<Relation> relation_;    // n x n, work layers
     std::vector<double> separation_;    // n x n, max(required, min_separation)
     std::vector<double> layer_weight_;  // per work layer
