@@ -1,7 +1,8 @@
 // Benchmarks of the collision-free simplification (issue 5), ratios measured in one run.
 //
 //   strata_bench_simplify paper            paper section 5.2: local vs global untangling
-//   strata_bench_simplify scenes [--max N] generated 5/8-layer scenes, per backend
+//   strata_bench_simplify scenes [options]  generated 5/8-layer scenes, per backend and
+//                                           schedule (options: see the usage line)
 //
 // Plain timers (std::chrono::steady_clock), one run per configuration: the machine is small
 // and noisy, so read ratios rather than absolute times.
@@ -10,6 +11,7 @@
 #include "strata/untangle/untangle.h"
 
 #include <sys/resource.h>
+#include <tbb/global_control.h>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -163,6 +166,7 @@ int main(int argc, char** argv) {
         paper();
     } else if (what == "scenes") {
         SceneFilter filter;
+        std::size_t threads = 0;  // 0: TBB's default (every core)
         for (int i = 2; i + 1 < argc; i += 2) {
             const std::string key = argv[i], value = argv[i + 1];
             if (key == "--min") {
@@ -173,6 +177,8 @@ int main(int argc, char** argv) {
                 filter.layers = std::strtoul(value.c_str(), nullptr, 10);
             } else if (key == "--remove") {
                 filter.remove = std::strtod(value.c_str(), nullptr);
+            } else if (key == "--threads") {
+                threads = std::strtoul(value.c_str(), nullptr, 10);
             } else if (key == "--schedule") {
                 filter.schedule = value;
             } else if (key == "--backend") {
@@ -182,12 +188,14 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
+        std::optional<tbb::global_control> limit;
+        if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
         scenes(filter);
     } else {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
-                     "[--schedule deferred|immediate]\n");
+                     "[--schedule deferred|immediate] [--threads N]\n");
         return 2;
     }
     return 0;
