@@ -145,33 +145,41 @@ TEST_CASE("several seeds of random decimation", "[simplify]") {
 }
 
 TEST_CASE("the result is the same at 1 and 2 threads", "[simplify]") {
-    // The untangling's projection steps run in parallel (TBB); the immediate schedule makes
-    // sure there is untangling to do.
-    const Scene input = stack(5, 300, false);
-    for (FieldBackend backend : {FieldBackend::Grid, FieldBackend::ExactIndexed}) {
-        for (UntangleSchedule schedule :
-             {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
-            SimplifyParams params;
-            params.decimator = "random";
-            params.remove = 0.95;
-            params.schedule = schedule;
-            params.untangling.field.backend = backend;
-            Scene one = input, two = input;
-            SimplifyReport r1, r2;
-            {
-                tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-                r1 = simplify(one, params);
-            }
-            {
-                tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-                r2 = simplify(two, params);
-            }
-            if (schedule == UntangleSchedule::Immediate) CHECK(r1.untangle_calls > 10);
-            CHECK(r1.untangle_calls == r2.untangle_calls);
-            CHECK(r1.rounds == r2.rounds);
-            for (std::size_t l = 0; l < one.size(); ++l)
-                CHECK(one.layer(l).points == two.layer(l).points);
+    // The untangling's projection steps run in parallel (TBB), and so do the grid's leaf
+    // computations; the immediate schedule makes sure there is untangling to do. The grid
+    // case is small and coarse (voxel 0.02): grid fields are costly at the default voxel.
+    struct Case {
+        FieldBackend backend;
+        UntangleSchedule schedule;
+        std::size_t layers, points;
+        double remove, voxel;
+    };
+    for (const Case& c :
+         {Case{FieldBackend::ExactIndexed, UntangleSchedule::Deferred, 5, 300, 0.95, 0.0},
+          Case{FieldBackend::ExactIndexed, UntangleSchedule::Immediate, 5, 300, 0.9, 0.0},
+          Case{FieldBackend::Grid, UntangleSchedule::Immediate, 3, 100, 0.8, 0.02}}) {
+        const Scene input = stack(c.layers, c.points, false);
+        SimplifyParams params;
+        params.decimator = "random";
+        params.remove = c.remove;
+        params.schedule = c.schedule;
+        params.untangling.field.backend = c.backend;
+        params.untangling.field.voxel_size = c.voxel;
+        Scene one = input, two = input;
+        SimplifyReport r1, r2;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            r1 = simplify(one, params);
         }
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+            r2 = simplify(two, params);
+        }
+        if (c.schedule == UntangleSchedule::Immediate) CHECK(r1.untangle_calls > 10);
+        CHECK(r1.untangle_calls == r2.untangle_calls);
+        CHECK(r1.rounds == r2.rounds);
+        for (std::size_t l = 0; l < one.size(); ++l)
+            CHECK(one.layer(l).points == two.layer(l).points);
     }
 }
 

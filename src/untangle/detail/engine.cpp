@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 
@@ -486,10 +487,34 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     result.converged = result.ok;  // nothing to do is a converged run
     const int total_rounds = params.max_rounds * params.max_passes;
     std::vector<std::vector<Vec2>> rest = shapes_of(work, pieces);  // shape matching's rest
+    // The fields are built once, then follow the moved vertices: each pass updates, per
+    // layer, the range of vertices that moved since (LayerField::update(), which equals a
+    // rebuild and, for the grid, recomputes only the leaves near the moves).
+    std::optional<SceneFields> built;
+    std::vector<std::vector<Vec2>> built_points;
     for (int pass = 0; pass < params.max_passes && !result.ok; ++pass) {
         ++result.passes;
         start = Clock::now();
-        const SceneFields fields(work, params.field, settings.outside_signs);
+        if (!built) {
+            built.emplace(work, params.field, settings.outside_signs);
+            for (const Layer& layer : work.layers()) built_points.push_back(layer.points);
+        } else {
+            for (std::size_t j = 0; j < work.size(); ++j) {
+                const std::vector<Vec2>& now = work.layer(j).points;
+                std::vector<Vec2>& then = built_points[j];
+                std::size_t first = now.size(), last = 0;
+                for (std::size_t v = 0; v < now.size(); ++v)
+                    if (now[v] != then[v]) {
+                        first = std::min(first, v);
+                        last = v;
+                    }
+                if (first > last) continue;
+                const std::size_t count = last - first + 1;
+                built->field(j).update(now, PolylineEdit{first, count, count});
+                then = now;
+            }
+        }
+        const SceneFields& fields = *built;
         result.seconds_fields += seconds_since(start);
         // Aim above the grid's interpolation error, or its fields cannot see the gap.
         const double separation =
