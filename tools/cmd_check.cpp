@@ -214,9 +214,11 @@ Run add_check_command(CLI::App& app) {
             // An open layer simplified to a few vertices gets its side from its original.
             for (std::size_t i = 0; i < scene.size(); ++i) {
                 const auto j = reference->find(scene.layer(i).name);
-                params.outside_sides.push_back(j && !reference->layer(*j).closed
-                                                   ? outside_side(*reference, *j)
-                                                   : outside_side(scene, i));
+                // The near distance the checker's own vote would use (0: automatic).
+                params.outside_sides.push_back(
+                    j && !reference->layer(*j).closed
+                        ? outside_side(*reference, *j, params.near_distance)
+                        : outside_side(scene, i, params.near_distance));
             }
         }
         const CheckReport report = check_scene(scene, params);

@@ -255,6 +255,13 @@ class Driver {
     }
 
     SimplifyReport& report() { return report_; }
+    /// outside_side() of every input layer (already resolved for the untangling, if any).
+    std::vector<int> outside_sides() const {
+        if (!settings_.outside_signs.empty()) return settings_.outside_signs;
+        std::vector<int> sides;
+        for (std::size_t l = 0; l < input_.size(); ++l) sides.push_back(outside_side(input_, l));
+        return sides;
+    }
     std::size_t target(std::size_t l) const { return layers_[l].target; }
 
   private:
@@ -669,8 +676,7 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     check_params.separation_tolerance = params.untangling.separation_tolerance;
     // The input's open-layer sides: vertex order is kept, and the vote of outside_side() is
     // unreliable on layers simplified to a few vertices.
-    for (std::size_t l = 0; l < scene.size(); ++l)
-        check_params.outside_sides.push_back(outside_side(scene, l));
+    check_params.outside_sides = driver.outside_sides();
     const CheckReport check = check_scene(out, check_params);
     report.crossings = check.crossing_count;
     report.self_crossings = check.total_self_crossings();

@@ -43,8 +43,8 @@ struct SimplifyParams {
     std::size_t n_out = 7;   ///< N_out: fixed collar vertices on both sides of a piece.
     UntangleSchedule schedule = UntangleSchedule::Deferred;  ///< See UntangleSchedule.
     /// Untangling settings. Defaults differ from untangle()'s: rounds of 10 projection steps,
-    /// one round per pass, 16 passes. Every pass rebuilds the fields from the current geometry
-    /// (cheap on the small local scenes), and within a pass each layer's own frozen field pulls
+    /// one round per pass, 16 passes. Every pass brings the fields up to date with the moved
+    /// vertices (LayerField::update()), and within a pass each layer's own frozen field pulls
     /// it back toward where the pass began; on generated 5/8-layer stacks this untangled 2.6x
     /// more removals in 1/5 of the time of 2 passes of 8 rounds of 30 steps (closing note of
     /// issue 5). A removal that does not untangle within them is rolled back.

@@ -109,7 +109,6 @@ class Pass {
          const UntangleParams& params, double min_separation, double sample_spacing)
         : fields_(fields),
           params_(params),
-          min_separation_(min_separation),
           sample_spacing_(sample_spacing),
           scratch_([&params] { return Scratch(params.composition); }) {
         double largest = 0.0;
@@ -163,8 +162,15 @@ class Pass {
             out.gradient = s.samples[layer].gradient;
             return out;
         }
-        if (is_chain_ && params_.composition.use_chain_fast_path && compose_chain_at(layer, s, out))
-            return out;
+        if (!(is_chain_ && params_.composition.use_chain_fast_path &&
+              compose_chain_at(layer, s, out)))
+            compose_general_at(s, out);
+        out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
+        return out;
+    }
+
+    // compose_at() with any constraint set: the members' pairwise constraints, `layer` first.
+    void compose_general_at(Scratch& s, Composed& out) const {
         const std::size_t n = fields_.size();
         for (std::size_t a = 0; a < s.members.size(); ++a) {
             s.f.push_back(s.samples[s.members[a]].value);
@@ -191,8 +197,6 @@ class Pass {
         out.fhat = r.fhat[0];
         for (std::size_t j = 0; j < s.members.size(); ++j)
             out.gradient += r.coefficient(0, j) * s.samples[s.members[j]].gradient;
-        out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
-        return out;
     }
 
     // compose_at() for members of distinct ranks in a chain scene: sorted innermost first,
@@ -219,7 +223,6 @@ class Pass {
         out.fhat = r.fhat[own];
         for (std::size_t j = 0; j < s.chain.size(); ++j)
             out.gradient += r.coefficient(own, j) * s.samples[s.chain[j]].gradient;
-        out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
         return true;
     }
 
@@ -395,7 +398,6 @@ class Pass {
   private:
     const SceneFields& fields_;
     const UntangleParams& params_;
-    double min_separation_ = 0.0;
     double sample_spacing_ = 0.0;
     double reach_ = 0.0;  // how far from an edge a vertex of another layer gets its own sample
     tbb::enumerable_thread_specific<Scratch> scratch_;
