@@ -89,6 +89,8 @@ struct SceneFilter {
     double remove = 0.0;                                            // 0: 0.8, 0.9, 0.95
     std::string backend;                                            // "": indexed and grid
     std::string schedule;                                           // "": deferred and immediate
+    std::size_t batch = 0;                                          // 0: SimplifyParams' default
+    std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
 };
 
 double max_hausdorff(const SimplifyReport& report) {
@@ -100,10 +102,12 @@ double max_hausdorff(const SimplifyReport& report) {
 void scenes(const SceneFilter& filter) {
     // strata s and naive s: whole simplify() calls, final exact check and Hausdorff included;
     // loop us/step: the removal loop alone (SimplifyReport::seconds_total) per kept removal.
-    std::printf("%-6s %-7s %-5s %-8s %-9s %8s %9s %7s %8s %8s %8s %8s %7s %5s %7s %9s %9s %6s\n",
-                "layers", "pts", "rm", "backend", "schedule", "naive s", "strata s", "ratio",
-                "us/step", "loop us", "deferred", "refused", "untangl", "cross", "gap/req",
-                "H naive", "H strata", "rss MB");
+    // thr: worker threads (0: every core); jobs/b: untanglings per batch (run side by side).
+    std::printf(
+        "%-6s %-7s %-5s %-8s %-9s %3s %8s %9s %7s %8s %8s %8s %8s %7s %6s %5s %7s %9s %9s %6s\n",
+        "layers", "pts", "rm", "backend", "schedule", "thr", "naive s", "strata s", "ratio",
+        "us/step", "loop us", "deferred", "refused", "untangl", "jobs/b", "cross", "gap/req",
+        "H naive", "H strata", "rss MB");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
         for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
             if (filter.layers != 0 && count != filter.layers) continue;
@@ -140,19 +144,30 @@ void scenes(const SceneFilter& filter) {
                         params.untangle = true;
                         params.schedule = schedule;
                         params.untangling.field.backend = backend;
-                        Scene s = input;
-                        t = now();
-                        const SimplifyReport r = simplify(s, params);
-                        const double ts = now() - t;
-                        std::printf(
-                            "%-6zu %-7zu %-5.2f %-8s %-9s %8.3f %9.3f %7.1f %8.2f %8.2f %8zu %8zu "
-                            "%7zu %5zu %7.3f %9.4f %9.4f %6ld\n",
-                            count, points, remove, name.c_str(), when.c_str(), tn, ts, ts / tn,
-                            1e6 * ts / static_cast<double>(r.removed),
-                            1e6 * r.seconds_total / static_cast<double>(r.removed), r.deferred,
-                            r.refused, r.untangle_calls, r.crossings, r.min_separation_ratio,
-                            max_hausdorff(rn), max_hausdorff(r), peak_rss_mb());
-                        std::fflush(stdout);
+                        if (filter.batch > 0) params.batch = filter.batch;
+                        for (std::size_t threads : filter.threads) {
+                            std::optional<tbb::global_control> limit;
+                            if (threads > 0)
+                                limit.emplace(tbb::global_control::max_allowed_parallelism,
+                                              threads);
+                            Scene s = input;
+                            t = now();
+                            const SimplifyReport r = simplify(s, params);
+                            const double ts = now() - t;
+                            std::printf(
+                                "%-6zu %-7zu %-5.2f %-8s %-9s %3zu %8.3f %9.3f %7.1f %8.2f %8.2f "
+                                "%8zu %8zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f %6ld\n",
+                                count, points, remove, name.c_str(), when.c_str(), threads, tn,
+                                ts, ts / tn, 1e6 * ts / static_cast<double>(r.removed),
+                                1e6 * r.seconds_total / static_cast<double>(r.removed),
+                                r.deferred, r.refused, r.untangle_calls,
+                                r.batches ? static_cast<double>(r.untangle_calls) /
+                                                static_cast<double>(r.batches)
+                                          : 0.0,
+                                r.crossings, r.min_separation_ratio, max_hausdorff(rn),
+                                max_hausdorff(r), peak_rss_mb());
+                            std::fflush(stdout);
+                        }
                     }
             }
         }
@@ -166,7 +181,6 @@ int main(int argc, char** argv) {
         paper();
     } else if (what == "scenes") {
         SceneFilter filter;
-        std::size_t threads = 0;  // 0: TBB's default (every core)
         for (int i = 2; i + 1 < argc; i += 2) {
             const std::string key = argv[i], value = argv[i + 1];
             if (key == "--min") {
@@ -177,8 +191,16 @@ int main(int argc, char** argv) {
                 filter.layers = std::strtoul(value.c_str(), nullptr, 10);
             } else if (key == "--remove") {
                 filter.remove = std::strtod(value.c_str(), nullptr);
-            } else if (key == "--threads") {
-                threads = std::strtoul(value.c_str(), nullptr, 10);
+            } else if (key == "--threads") {  // a list: 1,2
+                filter.threads.clear();
+                for (std::size_t at = 0; at < value.size();) {
+                    const std::size_t comma = std::min(value.find(',', at), value.size());
+                    filter.threads.push_back(
+                        std::strtoul(value.substr(at, comma - at).c_str(), nullptr, 10));
+                    at = comma + 1;
+                }
+            } else if (key == "--batch") {
+                filter.batch = std::strtoul(value.c_str(), nullptr, 10);
             } else if (key == "--schedule") {
                 filter.schedule = value;
             } else if (key == "--backend") {
@@ -188,14 +210,12 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
-        std::optional<tbb::global_control> limit;
-        if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
         scenes(filter);
     } else {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
-                     "[--schedule deferred|immediate] [--threads N]\n");
+                     "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N]\n");
         return 2;
     }
     return 0;

@@ -51,13 +51,16 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                           {"target", l.target},
                           {"refused", l.refused},
                           {"untangled", l.untangled},
-                          {"hausdorff", l.hausdorff}});
+                          {"hausdorff", l.hausdorff},
+                          {"max_displacement", l.max_displacement}});
     nlohmann::json j = {{"layers", layers},
                         {"removed", r.removed},
                         {"untangle_calls", r.untangle_calls},
                         {"refused", r.refused},
                         {"deferred", r.deferred},
                         {"rounds", r.rounds},
+                        {"batches", r.batches},
+                        {"batch_reruns", r.batch_reruns},
                         {"targets_met", r.targets_met},
                         {"crossings", r.crossings},
                         {"self_crossings", r.self_crossings},
@@ -279,6 +282,10 @@ Run add_simplify_command(CLI::App& app) {
                         "random | visvalingam | max-error (demo: random, as in the paper)")
             ->capture_default_str();
     cmd->add_option("--seed", p.seed, "Seed of the random decimator")->capture_default_str();
+    cmd->add_option("--untangle-batch", p.batch,
+                    "Untanglings run side by side when their regions keep apart (1: one at a "
+                    "time, the paper's order)")
+        ->capture_default_str();
     cmd->add_option("--n-out", p.n_out, "N_out: fixed collar vertices around each piece")
         ->capture_default_str();
     static const std::map<std::string, UntangleSchedule> schedules{
@@ -310,6 +317,7 @@ Run add_simplify_command(CLI::App& app) {
         SimplifyOptions o = *opt;
         if (o.inputs.empty() && decimator->count() == 0) o.params.decimator = "random";
         if (o.no_shape_matching) o.params.untangling.shape = ShapeMode::None;
+        if (o.params.batch < 1) throw InvalidInput("simplify: --untangle-batch must be >= 1 (got 0)");
         validate(o.params);
         if (o.threads < 0)
             throw InvalidInput("simplify: --threads must be >= 0 (got " +

@@ -8,12 +8,15 @@
 #include "untangle/detail/engine.h"
 
 #include <glm/geometric.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <unordered_map>
 
@@ -36,6 +39,8 @@ struct SegRef {
 class SegmentGrid {
   public:
     explicit SegmentGrid(double cell) : cell_(cell) {}
+    double cell() const { return cell_; }
+    void clear() { cells_.clear(); }
 
     void insert(SegRef s, const Box2& box) {
         for_cells(box, [&](std::uint64_t key) { cells_[key].push_back(s); });
@@ -173,6 +178,9 @@ class Driver {
         stamp_.resize(n);
         for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
         mark_ = stamp_;
+        slot_run_ = stamp_;
+        slot_index_ = stamp_;
+        for (double r : reach_) max_reach_ = std::max(max_reach_, r);
         version_.resize(n);
         for (std::size_t l = 0; l < n; ++l) version_[l].assign(layers_[l].alive.size(), 0);
         if (params.untangle) settings_ = detail::resolve_settings(scene, params.untangling);
@@ -185,7 +193,7 @@ class Driver {
         for (const WorkLayer& w : layers_) to_remove += w.alive_count - w.target;
         for (std::size_t l = 0; l < layers_.size(); ++l)
             for (std::size_t v = 0; v < layers_[l].alive.size(); ++v) push(l, v);
-        std::size_t done = 0, last_reported = 0;
+        std::size_t last_reported = 0;
         // Deferred schedule: a first sweep removes what needs no untangling; a second one
         // untangles, over the layers still above their target only.
         defer_ = params_.untangle && params_.schedule == UntangleSchedule::Deferred;
@@ -196,7 +204,11 @@ class Driver {
                     if (layers_[l].alive_count > layers_[l].target)
                         for (std::size_t v = 0; v < layers_[l].alive.size(); ++v) push(l, v);
             }
-            while (!queue_.empty()) {
+            for (;;) {
+                if (queue_.empty()) {
+                    flush();  // its commits may bring new candidates
+                    if (queue_.empty()) break;
+                }
                 const Candidate c = queue_.top();
                 queue_.pop();
                 const std::size_t l = c.layer, v = c.vertex;
@@ -208,23 +220,13 @@ class Driver {
                     w.locked[v] = 1;
                     continue;
                 }
-                switch (try_remove(l, v)) {
-                    case Outcome::Removed:
-                        ++report_.removed;
-                        ++done;
-                        break;
-                    case Outcome::Deferred:
-                        ++report_.deferred;
-                        break;
-                    case Outcome::Refused:
-                        w.locked[v] = 1;
-                        ++report_.refused;
-                        ++report_.layers[l].refused;
-                        break;
-                }
-                if (progress && (done - last_reported) * 100 >= to_remove) {
-                    last_reported = done;
-                    if (!progress("simplify", to_remove ? static_cast<double>(done) /
+                if (batching())
+                    remove_batched(c);
+                else
+                    count(try_remove(l, v), l, v);
+                if (progress && (done_ - last_reported) * 100 >= to_remove) {
+                    last_reported = done_;
+                    if (!progress("simplify", to_remove ? static_cast<double>(done_) /
                                                               static_cast<double>(to_remove)
                                                         : 1.0))
                         throw Cancelled();
@@ -263,6 +265,14 @@ class Driver {
         return sides;
     }
     std::size_t target(std::size_t l) const { return layers_[l].target; }
+    /// Largest distance of a kept vertex of layer l from its input position.
+    double max_displacement(std::size_t l) const {
+        const WorkLayer& w = layers_[l];
+        double d = 0.0;
+        for (std::size_t i = 0; i < w.alive.size(); ++i)
+            if (w.alive[i]) d = std::max(d, glm::distance(w.pos[i], w.original[i]));
+        return d;
+    }
 
   private:
     static SegRef ref(std::size_t l, std::size_t i) {
@@ -296,7 +306,7 @@ class Driver {
             {cost, static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(v), ++version_[l][v]});
     }
 
-    // Calls f(layer, start) once per segment whose box meets `box`.
+    // Calls f(layer, start) once per segment whose box meets `box` (driver's positions).
     template <class F>
     void segments_near(const Box2& box, F&& f) {
         ++stamp_counter_;
@@ -308,20 +318,86 @@ class Driver {
         });
     }
 
+    // A run of alive vertices of one layer, in order, standing for one work layer.
+    struct Run {
+        std::size_t layer = 0;
+        std::vector<std::size_t> ids;
+        bool whole_loop = false;
+    };
+
+    // One local untangling: prepared from the driver's state, run without writing to it (so
+    // that untanglings whose footprints keep apart run side by side), then committed.
+    struct Job {
+        std::size_t l = 0, a = 0, v = 0, b = 0;  // removal of v between a and b, layer l
+        Vec2 removed{};
+        std::uint32_t stamp = 0;  // mark_ value of the runs' vertices
+        std::vector<Run> runs;
+        std::vector<Piece> pieces;
+        std::vector<SegRef> moving;  // segments with a free end
+        std::optional<Scene> work;
+        detail::RelationSource relations;
+        detail::EngineSettings settings;
+        Box2 footprint;  // the runs' vertices before, and the removed one
+        detail::EngineResult result;
+        double seconds_prepare = 0.0;
+    };
+
+    // Where the checks read positions: the driver's, or over a job's runs its work scene.
+    struct Overlay {
+        const Job* job = nullptr;
+        const Scene* work = nullptr;
+        const SegmentGrid* moving = nullptr;  // the job's moving segments where they are now
+    };
+
+    Vec2 pos(std::size_t k, std::size_t x, const Overlay& ov) const {
+        if (ov.job && mark_[k][x] == ov.job->stamp)
+            return ov.work->layer(slot_run_[k][x]).points[slot_index_[k][x]];
+        return layers_[k].pos[x];
+    }
+    bool is_free(std::size_t k, std::size_t x, const Job& job) const {
+        return x != kNone && mark_[k][x] == job.stamp &&
+               job.pieces[slot_run_[k][x]].is_free[slot_index_[k][x]];
+    }
+
+    // Calls f(layer, start) once per segment whose box meets `box`, at the overlay's
+    // positions. With a job, writes nothing the driver shares (jobs run side by side).
+    template <class F>
+    void near(const Box2& box, const Overlay& ov, F&& f) {
+        if (!ov.job) {
+            segments_near(box, f);
+            return;
+        }
+        std::vector<SegRef> found;
+        grid_.query(box, [&](SegRef s) {  // the grid holds the moving ones where they were
+            if (!is_free(s.layer, s.start, *ov.job) &&
+                !is_free(s.layer, layers_[s.layer].next[s.start], *ov.job))
+                found.push_back(s);
+        });
+        ov.moving->query(box, [&](SegRef s) { found.push_back(s); });
+        auto key = [](const SegRef& s) {
+            return (static_cast<std::uint64_t>(s.layer) << 32) | s.start;
+        };
+        std::sort(found.begin(), found.end(),
+                  [&](const SegRef& x, const SegRef& y) { return key(x) < key(y); });
+        found.erase(std::unique(found.begin(), found.end(),
+                                [&](const SegRef& x, const SegRef& y) { return key(x) == key(y); }),
+                    found.end());
+        for (const SegRef& s : found)
+            f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+    }
+
     // Segment (a, b) of layer l meets no other segment and keeps its separations.
-    bool segment_clear(std::size_t l, std::size_t a, std::size_t b) {
-        const WorkLayer& w = layers_[l];
-        const Vec2 p = w.pos[a], q = w.pos[b];
+    bool segment_clear(std::size_t l, std::size_t a, std::size_t b, const Overlay& ov) {
+        const Vec2 p = pos(l, a, ov), q = pos(l, b, ov);
         Box2 box;
         box.extend(p);
         box.extend(q);
         bool ok = true;
-        segments_near(box.inflated(reach_[l]), [&](std::size_t k, std::size_t u) {
+        near(box.inflated(reach_[l]), ov, [&](std::size_t k, std::size_t u) {
             if (!ok) return;
-            const WorkLayer& o = layers_[k];
-            const std::size_t u2 = o.next[u];
+            const std::size_t u2 = layers_[k].next[u];
             if (k == l && (u == a || u == b || u2 == a || u2 == b)) return;
-            const Vec2 s0 = o.pos[u], s1 = o.pos[u2];
+            const Vec2 s0 = pos(k, u, ov), s1 = pos(k, u2, ov);
             if (segment_contact(p, q, s0, s1) != SegmentContact::None) {
                 ok = false;
                 return;
@@ -333,20 +409,19 @@ class Driver {
     }
 
     // No vertex but a, b of any layer lies in the closed triangle (a, removed, b).
-    bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b) {
-        const WorkLayer& w = layers_[l];
-        const Vec2 pa = w.pos[a], pb = w.pos[b];
+    bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
+                        const Overlay& ov) {
+        const Vec2 pa = pos(l, a, ov), pb = pos(l, b, ov);
         Box2 box;
         box.extend(pa);
         box.extend(pb);
         box.extend(removed);
         bool ok = true;
-        segments_near(box, [&](std::size_t k, std::size_t u) {
+        near(box, ov, [&](std::size_t k, std::size_t u) {
             if (!ok) return;
-            const WorkLayer& o = layers_[k];
-            for (std::size_t x : {u, o.next[u]}) {
+            for (std::size_t x : {u, layers_[k].next[u]}) {
                 if (k == l && (x == a || x == b)) continue;
-                if (point_in_closed_triangle(pa, removed, pb, o.pos[x])) {
+                if (point_in_closed_triangle(pa, removed, pb, pos(k, x, ov))) {
                     ok = false;
                     return;
                 }
@@ -356,14 +431,14 @@ class Driver {
     }
 
     // Winding number of closed layer l around p (exact orientation tests).
-    int winding(std::size_t l, const Vec2& p) const {
+    int winding(std::size_t l, const Vec2& p, const Overlay& ov) const {
         const WorkLayer& w = layers_[l];
         int wn = 0;
         const std::size_t start = w.first();
         std::size_t i = start;
         do {
             const std::size_t j = w.next[i];
-            const Vec2 a = w.pos[i], b = w.pos[j];
+            const Vec2 a = pos(l, i, ov), b = pos(l, j, ov);
             if (a.y <= p.y) {
                 if (b.y > p.y && orient2d(a, b, p) > 0) ++wn;
             } else if (b.y <= p.y && orient2d(a, b, p) < 0) {
@@ -377,23 +452,23 @@ class Driver {
     // Every vertex of `ids` (layer l) is inside the closed layers it is under and outside the
     // closed layers it is over or beside: moving vertices can carry a whole small loop out of
     // another without any crossing left at the end.
-    bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids) const {
+    bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids, const Overlay& ov) const {
         for (std::size_t k = 0; k < layers_.size(); ++k) {
             if (k == l || !layers_[k].closed) continue;
             const Relation rel = input_.relation(l, k);
             for (std::size_t id : ids) {
-                const bool inside = winding(k, layers_[l].pos[id]) != 0;
+                const bool inside = winding(k, pos(l, id, ov), ov) != 0;
                 if (inside != (rel == Relation::Under)) return false;
             }
         }
         return true;
     }
 
-    bool closed_valid(std::size_t l) const {
+    bool closed_valid(std::size_t l, const Overlay& ov) const {
         const WorkLayer& w = layers_[l];
         if (!w.closed || w.alive_count > 3) return true;
         const std::size_t i = w.first(), j = w.next[i], k = w.next[j];
-        return orient2d(w.pos[i], w.pos[j], w.pos[k]) != 0;
+        return orient2d(pos(l, i, ov), pos(l, j, ov), pos(l, k, ov)) != 0;
     }
 
     void unlink(std::size_t l, std::size_t v) {
@@ -434,41 +509,69 @@ class Driver {
 
     enum class Outcome { Removed, Deferred, Refused };
 
-    Outcome try_remove(std::size_t l, std::size_t v) {
+    void count(Outcome outcome, std::size_t l, std::size_t v) {
+        switch (outcome) {
+            case Outcome::Removed:
+                ++report_.removed;
+                ++done_;
+                break;
+            case Outcome::Deferred:
+                ++report_.deferred;
+                break;
+            case Outcome::Refused:
+                layers_[l].locked[v] = 1;
+                ++report_.refused;
+                ++report_.layers[l].refused;
+                break;
+        }
+    }
+
+    // Unlinks v; true when that alone keeps its region collision-free.
+    bool remove_if_clear(std::size_t l, std::size_t v) {
         WorkLayer& w = layers_[l];
         const std::size_t a = w.prev[v], b = w.next[v];
         const Vec2 removed = w.pos[v];
-        auto start = Clock::now();
+        const auto start = Clock::now();
         unlink(l, v);
-        const bool clear =
-            !params_.untangle ||
-            (closed_valid(l) && triangle_empty(l, a, removed, b) && segment_clear(l, a, b));
+        const Overlay driver;
+        const bool clear = !params_.untangle ||
+                           (closed_valid(l, driver) && triangle_empty(l, a, removed, b, driver) &&
+                            segment_clear(l, a, b, driver));
         report_.seconds_check += seconds_since(start);
         if (clear) {
             push(l, a);
             push(l, b);
-            return Outcome::Removed;
         }
-        if (!defer_ && untangle_around(l, a, removed, b)) return Outcome::Removed;
+        return clear;
+    }
+
+    // One removal at a time (no batch): the paper's order.
+    Outcome try_remove(std::size_t l, std::size_t v) {
+        if (remove_if_clear(l, v)) return Outcome::Removed;
+        if (!defer_ && untangle_now(l, v)) return Outcome::Removed;
         relink(l, v);
         return defer_ ? Outcome::Deferred : Outcome::Refused;
     }
 
-    // A run of alive vertices of one layer, in order, standing for one work layer.
-    struct Run {
-        std::size_t layer = 0;
-        std::vector<std::size_t> ids;
-        bool whole_loop = false;
-    };
-
-    // Marks vertex v of layer k for the current untangling (stamp_ style, no clearing).
+    // Marks vertex v of layer k for the job being prepared (stamp style, no clearing); a
+    // vertex of a job waiting in the batch is left alone and flags a conflict.
     void mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked) {
-        if (mark_[k][v] == mark_counter_) return;
+        const std::uint32_t m = mark_[k][v];
+        if (m == mark_counter_) return;
+        if (m != 0 && is_pending_stamp(m)) {
+            conflict_ = true;
+            return;
+        }
         mark_[k][v] = mark_counter_;
         marked.push_back(v);
     }
     bool is_marked(std::size_t k, std::size_t v) const {
         return v != kNone && mark_[k][v] == mark_counter_;
+    }
+    bool is_pending_stamp(std::uint32_t m) const {
+        for (const Job& job : pending_)
+            if (job.stamp == m) return true;
+        return false;
     }
 
     // Runs of layer k through its `marked` vertices, extended by n_out on both sides, in the
@@ -507,21 +610,31 @@ class Driver {
         }
     }
 
-    bool untangle_around(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b) {
-        WorkLayer& w = layers_[l];
-        ++report_.untangle_calls;
-        ++report_.layers[l].untangled;
-        auto start = Clock::now();
+    bool meets_pending(const Box2& box) const {
+        for (const Job& job : pending_)
+            if (job.footprint.overlaps(box)) return true;
+        return false;
+    }
+
+    enum class Prepared { Ready, Conflict, Refused };
+
+    // The work scene of the untangling after removing job.v (already unlinked): runs of every
+    // layer through the segments near the removal, their vertices in the region free.
+    // Conflict: it would share vertices or come within reach of a job waiting in the batch.
+    Prepared prepare(Job& job) {
+        const auto start = Clock::now();
+        const WorkLayer& w = layers_[job.l];
         Box2 box;
-        box.extend(w.pos[a]);
-        box.extend(w.pos[b]);
-        box.extend(removed);
-        const double chord = glm::distance(w.pos[a], w.pos[b]);
-        const Box2 region = box.inflated(std::max(2.0 * nest_thickness_[l], 0.5 * chord));
-        const Box2 around = region.inflated(std::max(2.0 * nest_thickness_[l], chord));
+        box.extend(w.pos[job.a]);
+        box.extend(w.pos[job.b]);
+        box.extend(job.removed);
+        const double chord = glm::distance(w.pos[job.a], w.pos[job.b]);
+        const Box2 region = box.inflated(std::max(2.0 * nest_thickness_[job.l], 0.5 * chord));
+        const Box2 around = region.inflated(std::max(2.0 * nest_thickness_[job.l], chord));
         // Work layers: runs through the vertices of the segments near the region.
         std::vector<std::vector<std::size_t>> marked(layers_.size());
-        ++mark_counter_;
+        job.stamp = ++mark_counter_;
+        conflict_ = false;
         if (params_.global) {
             for (std::size_t k = 0; k < layers_.size(); ++k)
                 for (std::size_t v = 0; v < layers_[k].alive.size(); ++v)
@@ -532,21 +645,28 @@ class Driver {
                 mark(k, layers_[k].next[u], marked[k]);
             });
         }
-        std::vector<Run> runs;
-        for (std::size_t k = 0; k < layers_.size(); ++k)
-            if (!marked[k].empty()) runs_of(k, marked[k], runs);
+        job.runs.clear();
+        for (std::size_t k = 0; k < layers_.size() && !conflict_; ++k)
+            if (!marked[k].empty()) runs_of(k, marked[k], job.runs);
+        if (conflict_) return Prepared::Conflict;
+        job.footprint = Box2{};
+        job.footprint.extend(job.removed);
+        for (const Run& run : job.runs)
+            for (std::size_t id : run.ids) job.footprint.extend(layers_[run.layer].pos[id]);
+        if (meets_pending(job.footprint.inflated(max_reach_))) return Prepared::Conflict;
 
         std::vector<Layer> work_layers;
-        std::vector<Piece> pieces;
-        detail::RelationSource relations;
-        relations.scene = &input_;
-        detail::EngineSettings settings = settings_;
-        settings.outside_signs.clear();
-        settings.check_every_step = !params_.global;
-        settings.rest_at_start = true;  // passes of one round: match toward the start
-        for (std::size_t r = 0; r < runs.size(); ++r) {
-            const Run& run = runs[r];
+        job.pieces.clear();
+        job.relations = detail::RelationSource{};
+        job.relations.scene = &input_;
+        job.settings = settings_;
+        job.settings.outside_signs.clear();
+        job.settings.check_every_step = !params_.global;
+        job.settings.rest_at_start = true;  // passes of one round: match toward the start
+        for (std::size_t r = 0; r < job.runs.size(); ++r) {
+            const Run& run = job.runs[r];
             const Layer& parent = input_.layer(run.layer);
+            const WorkLayer& parent_work = layers_[run.layer];
             Layer layer;
             layer.name = parent.name + "#" + std::to_string(r);
             layer.closed = run.whole_loop;
@@ -557,83 +677,247 @@ class Driver {
             Piece piece;
             piece.layer = r;
             piece.is_whole_loop = run.whole_loop;
-            for (std::size_t id : run.ids) {
-                const Vec2 p = layers_[run.layer].pos[id];
+            for (std::size_t k = 0; k < run.ids.size(); ++k) {
+                const std::size_t id = run.ids[k];
+                const Vec2 p = parent_work.pos[id];
                 if (!layer.points.empty() && layer.points.back() == p)
-                    return false;  // would be merged
+                    return Prepared::Refused;  // would be merged
                 layer.points.push_back(p);
-                piece.vertices.push_back(piece.vertices.size());
+                piece.vertices.push_back(k);
                 // Open layers keep their end vertices where they are.
-                const WorkLayer& parent_work = layers_[run.layer];
                 const bool is_end = !parent_work.closed && (parent_work.prev[id] == kNone ||
                                                             parent_work.next[id] == kNone);
-                piece.is_free.push_back(!is_end && (params_.global || region.contains(p)) ? 1 : 0);
+                piece.is_free.push_back(!is_end && (params_.global || region.contains(p)) ? 1
+                                                                                           : 0);
+                slot_run_[run.layer][id] = static_cast<std::uint32_t>(r);
+                slot_index_[run.layer][id] = static_cast<std::uint32_t>(k);
             }
-            if (layer.closed && layer.points.front() == layer.points.back()) return false;
+            if (layer.closed && layer.points.front() == layer.points.back())
+                return Prepared::Refused;
             work_layers.push_back(std::move(layer));
-            pieces.push_back(std::move(piece));
-            relations.parent.push_back(run.layer);
-            settings.outside_signs.push_back(settings_.outside_signs[run.layer]);
+            job.pieces.push_back(std::move(piece));
+            job.relations.parent.push_back(run.layer);
+            job.settings.outside_signs.push_back(settings_.outside_signs[run.layer]);
         }
-        Scene work(std::move(work_layers));
-        // Positions to restore on failure.
-        std::vector<Vec2> saved;
-        for (const Run& run : runs)
-            for (std::size_t id : run.ids) saved.push_back(layers_[run.layer].pos[id]);
-        report_.seconds_check += seconds_since(start);
+        job.work.emplace(std::move(work_layers));
+        job.moving.clear();
+        for (const Run& run : job.runs) {
+            const WorkLayer& o = layers_[run.layer];
+            for (std::size_t id : run.ids)
+                if (o.next[id] != kNone &&
+                    (is_free(run.layer, id, job) || is_free(run.layer, o.next[id], job)))
+                    job.moving.push_back(ref(run.layer, id));
+        }
+        job.seconds_prepare = seconds_since(start);
+        return Prepared::Ready;
+    }
 
-        auto apply = [&](const Scene& s) {
-            for (std::size_t r = 0; r < runs.size(); ++r)
-                for (std::size_t k = 0; k < runs[r].ids.size(); ++k)
-                    if (pieces[r].is_free[k])
-                        move(runs[r].layer, runs[r].ids[k], s.layer(r).points[k]);
-        };
+    // Runs the job's untangling, checking its region exactly after every projection step.
+    // Reads the driver's state and writes only to `job`: jobs of one batch run side by side.
+    void execute(Job& job) {
+        SegmentGrid moving(grid_.cell());
         auto is_ok = [&](const Scene& s) {
-            apply(s);
-            if (!closed_valid(l) || !triangle_empty(l, a, removed, b) || !segment_clear(l, a, b))
+            const Overlay ov{&job, &s, &moving};
+            moving.clear();
+            for (const SegRef& seg : job.moving) {
+                Box2 box;
+                box.extend(pos(seg.layer, seg.start, ov));
+                box.extend(pos(seg.layer, layers_[seg.layer].next[seg.start], ov));
+                moving.insert(seg, box);
+            }
+            const std::size_t l = job.l;
+            if (!closed_valid(l, ov) || !triangle_empty(l, job.a, job.removed, job.b, ov) ||
+                !segment_clear(l, job.a, job.b, ov))
                 return false;
-            for (std::size_t r = 0; r < runs.size(); ++r) {
-                const WorkLayer& o = layers_[runs[r].layer];
-                for (std::size_t k = 0; k < runs[r].ids.size(); ++k) {
-                    if (!pieces[r].is_free[k]) continue;
-                    const std::size_t id = runs[r].ids[k];
-                    if (o.prev[id] != kNone && !segment_clear(runs[r].layer, o.prev[id], id))
+            for (std::size_t r = 0; r < job.runs.size(); ++r) {
+                const Run& run = job.runs[r];
+                const WorkLayer& o = layers_[run.layer];
+                for (std::size_t k = 0; k < run.ids.size(); ++k) {
+                    if (!job.pieces[r].is_free[k]) continue;
+                    const std::size_t id = run.ids[k];
+                    if (o.prev[id] != kNone && !segment_clear(run.layer, o.prev[id], id, ov))
                         return false;
-                    if (o.next[id] != kNone && !segment_clear(runs[r].layer, id, o.next[id]))
+                    if (o.next[id] != kNone && !segment_clear(run.layer, id, o.next[id], ov))
                         return false;
                 }
-                if (!closed_valid(runs[r].layer)) return false;
+                if (!closed_valid(run.layer, ov)) return false;
             }
             // Nesting of the region's vertices against every closed layer near it.
-            for (const Run& run : runs)
-                if (!nesting_kept(run.layer, run.ids)) return false;
+            for (const Run& run : job.runs)
+                if (!nesting_kept(run.layer, run.ids, ov)) return false;
             return true;
         };
-        const detail::EngineResult result =
-            detail::run_engine(work, pieces, params_.untangling, relations, settings, is_ok, {});
-        report_.rounds += result.rounds;
-        report_.seconds_fields += result.seconds_fields;
-        report_.seconds_untangle += result.seconds_untangle;
-        report_.seconds_check += result.seconds_check;
-        if (result.ok) {
-            push(l, a);
-            push(l, b);
-            for (std::size_t r = 0; r < runs.size(); ++r)
-                for (std::size_t k = 0; k < runs[r].ids.size(); ++k)
-                    if (pieces[r].is_free[k]) {
-                        const std::size_t id = runs[r].ids[k];
-                        push(runs[r].layer, id);
-                        const WorkLayer& o = layers_[runs[r].layer];
-                        if (o.prev[id] != kNone) push(runs[r].layer, o.prev[id]);
-                        if (o.next[id] != kNone) push(runs[r].layer, o.next[id]);
-                    }
-            return true;
-        }
-        std::size_t k = 0;
-        for (const Run& run : runs)
-            for (std::size_t id : run.ids) move(run.layer, id, saved[k++]);
-        return false;
+        job.result = detail::run_engine(*job.work, job.pieces, params_.untangling,
+                                        job.relations, job.settings, is_ok, {});
     }
+
+    // The box of the job's vertices before and after, and of the removed vertex.
+    Box2 reach_of(const Job& job) const {
+        Box2 box = job.footprint;
+        for (std::size_t r = 0; r < job.runs.size(); ++r)
+            for (const Vec2& p : job.work->layer(r).points) box.extend(p);
+        return box;
+    }
+
+    // Applies a successful job's moves; true if it succeeded.
+    bool commit(const Job& job) {
+        ++report_.untangle_calls;
+        ++report_.layers[job.l].untangled;
+        report_.rounds += job.result.rounds;
+        report_.seconds_check += job.seconds_prepare;
+        report_.seconds_fields += job.result.seconds_fields;
+        report_.seconds_untangle += job.result.seconds_untangle;
+        report_.seconds_check += job.result.seconds_check;
+        if (!job.result.ok) return false;
+        push(job.l, job.a);
+        push(job.l, job.b);
+        for (std::size_t r = 0; r < job.runs.size(); ++r) {
+            const Run& run = job.runs[r];
+            for (std::size_t k = 0; k < run.ids.size(); ++k)
+                if (job.pieces[r].is_free[k]) move(run.layer, run.ids[k], job.work->layer(r).points[k]);
+        }
+        for (std::size_t r = 0; r < job.runs.size(); ++r) {
+            const Run& run = job.runs[r];
+            const WorkLayer& o = layers_[run.layer];
+            for (std::size_t k = 0; k < run.ids.size(); ++k)
+                if (job.pieces[r].is_free[k]) {
+                    const std::size_t id = run.ids[k];
+                    push(run.layer, id);
+                    if (o.prev[id] != kNone) push(run.layer, o.prev[id]);
+                    if (o.next[id] != kNone) push(run.layer, o.next[id]);
+                }
+        }
+        return true;
+    }
+
+    static Job job_for(const WorkLayer& w, std::size_t l, std::size_t v) {
+        Job job;
+        job.l = l;
+        job.a = w.prev[v];
+        job.v = v;
+        job.b = w.next[v];
+        job.removed = w.pos[v];
+        return job;
+    }
+
+    // Untangles after removing v (unlinked) right away; true if kept.
+    bool untangle_now(std::size_t l, std::size_t v) {
+        ++report_.batches;  // a batch of one
+        Job job = job_for(layers_[l], l, v);
+        if (prepare(job) != Prepared::Ready) {  // no job waits: never a conflict
+            ++report_.untangle_calls;
+            ++report_.layers[l].untangled;
+            return false;
+        }
+        execute(job);
+        return commit(job);
+    }
+
+    // Batched removal of candidate v (immediate untangling): a removal that needs untangling
+    // waits in the batch; the batch runs when full, when a removal comes within reach of one
+    // of its jobs, or when the queue is empty.
+    void remove_batched(const Candidate& c) {
+        const std::size_t l = c.layer, v = c.vertex;
+        WorkLayer& w = layers_[l];
+        Box2 touch;
+        touch.extend(w.pos[w.prev[v]]);
+        touch.extend(w.pos[v]);
+        touch.extend(w.pos[w.next[v]]);
+        // Near a waiting job (or on a closed layer down to a few vertices, whose validity
+        // reads the whole layer): set aside until the batch has run.
+        if (!pending_.empty() &&
+            (meets_pending(touch.inflated(max_reach_)) || (w.closed && w.alive_count <= 4))) {
+            postpone(c);
+            return;
+        }
+        if (remove_if_clear(l, v)) {
+            if (!pending_.empty()) touched_.push_back({touch, pending_.size()});
+            count(Outcome::Removed, l, v);
+            return;
+        }
+        Job job = job_for(w, l, v);
+        const Prepared prepared = prepare(job);
+        if (prepared == Prepared::Conflict) {  // its region meets a waiting job's
+            relink(l, v);
+            postpone(c);
+            return;
+        }
+        if (prepared == Prepared::Refused) {
+            ++report_.untangle_calls;
+            ++report_.layers[l].untangled;
+            relink(l, v);
+            count(Outcome::Refused, l, v);
+            return;
+        }
+        pending_.push_back(std::move(job));
+        if (pending_.size() >= params_.batch || (w.closed && w.alive_count <= 3)) flush();
+    }
+
+    // Sets candidate c aside until the batch has run; runs it when too many wait.
+    void postpone(const Candidate& c) {
+        postponed_.push_back(c);
+        if (postponed_.size() >= 4 * params_.batch) flush();
+    }
+
+    // Runs the waiting jobs side by side (TBB), then commits them in the order they came. A
+    // job whose vertices, before or after, came within reach of another's (or of a removal
+    // made while it waited) is run again alone afterwards, so the outcome is the same at any
+    // thread count.
+    void flush() {
+        if (pending_.empty()) {
+            for (const Candidate& c : postponed_) queue_.push(c);
+            postponed_.clear();
+            return;
+        }
+        ++report_.batches;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pending_.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i != range.end(); ++i)
+                                  execute(pending_[i]);
+                          });
+        std::vector<Job> jobs = std::move(pending_);
+        pending_.clear();
+        std::vector<Box2> reached(jobs.size());
+        for (std::size_t i = 0; i < jobs.size(); ++i) reached[i] = reach_of(jobs[i]);
+        std::vector<std::size_t> again;
+        for (std::size_t i = 0; i < jobs.size(); ++i) {
+            const Box2 mine = reached[i].inflated(max_reach_);
+            bool independent = true;
+            for (std::size_t j = 0; j < jobs.size() && independent; ++j)
+                if (j != i && mine.overlaps(reached[j])) independent = false;
+            for (const Touched& t : touched_)
+                if (i < t.jobs_before && mine.overlaps(t.box)) independent = false;
+            if (!independent) {
+                again.push_back(i);
+                continue;
+            }
+            const Job& job = jobs[i];
+            if (commit(job)) {
+                count(Outcome::Removed, job.l, job.v);
+            } else {
+                relink(job.l, job.v);
+                count(Outcome::Refused, job.l, job.v);
+            }
+        }
+        touched_.clear();
+        for (const Candidate& c : postponed_) queue_.push(c);
+        postponed_.clear();
+        for (std::size_t i : again) {
+            const Job& job = jobs[i];
+            report_.seconds_fields += job.result.seconds_fields;  // the first run's time
+            report_.seconds_untangle += job.result.seconds_untangle;
+            report_.seconds_check += job.result.seconds_check + job.seconds_prepare;
+            ++report_.batch_reruns;
+            if (untangle_now(job.l, job.v)) {
+                count(Outcome::Removed, job.l, job.v);
+            } else {
+                relink(job.l, job.v);
+                count(Outcome::Refused, job.l, job.v);
+            }
+        }
+    }
+
+    bool batching() const { return params_.untangle && !defer_ && !params_.global; }
 
     const Scene& input_;
     const SimplifyParams& params_;
@@ -644,8 +928,19 @@ class Driver {
     std::vector<double> reach_, nest_thickness_;
     std::vector<std::vector<std::uint32_t>> stamp_, version_;
     std::uint32_t stamp_counter_ = 0;
-    std::vector<std::vector<std::uint32_t>> mark_;  // runs of the current untangling
+    std::vector<std::vector<std::uint32_t>> mark_;  // a job's runs: the job's stamp
     std::uint32_t mark_counter_ = 0;
+    std::vector<std::vector<std::uint32_t>> slot_run_, slot_index_;  // where in its job's runs
+    bool conflict_ = false;  // prepare() met a waiting job
+    double max_reach_ = 0.0;  // largest separation needed between two layers
+    struct Touched {
+        Box2 box;                     // a removal made while jobs waited
+        std::size_t jobs_before = 0;  // jobs waiting then
+    };
+    std::vector<Job> pending_;  // the batch
+    std::vector<Touched> touched_;
+    std::vector<Candidate> postponed_;  // set aside until the batch has run
+    std::size_t done_ = 0;
     bool defer_ = false;  // this sweep sets conflicting removals aside
     std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
     detail::EngineSettings settings_;
@@ -661,6 +956,8 @@ void validate(const SimplifyParams& params) {
     if (!(params.max_error >= 0.0) || !std::isfinite(params.max_error))
         throw InvalidInput("simplify: params.max_error must be >= 0 and finite (got " +
                            format_number(params.max_error) + ")");
+    if (params.batch < 1)
+        throw InvalidInput("simplify: params.batch must be >= 1 (got 0)");
     make_decimator(params.decimator, params.seed);
     validate(params.untangling);
 }
@@ -693,6 +990,7 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
         r.before = before.points.size();
         r.after = after.points.size();
         r.target = driver.target(l);
+        r.max_displacement = driver.max_displacement(l);
         if (r.after > r.target) report.targets_met = false;
         r.hausdorff = hausdorff(after, before, tolerance).symmetric();
     }

@@ -175,8 +175,13 @@ TEST_CASE("the result is the same at 1 and 2 threads", "[simplify]") {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
             r2 = simplify(two, params);
         }
-        if (c.schedule == UntangleSchedule::Immediate) CHECK(r1.untangle_calls > 10);
+        if (c.schedule == UntangleSchedule::Immediate) {
+            CHECK(r1.untangle_calls > 10);
+            CHECK(r1.untangle_calls > r1.batches);  // some batch ran jobs side by side
+        }
         CHECK(r1.untangle_calls == r2.untangle_calls);
+        CHECK(r1.batches == r2.batches);
+        CHECK(r1.batch_reruns == r2.batch_reruns);
         CHECK(r1.rounds == r2.rounds);
         for (std::size_t l = 0; l < one.size(); ++l)
             CHECK(one.layer(l).points == two.layer(l).points);
@@ -260,6 +265,9 @@ TEST_CASE("bad simplify parameters are rejected by name", "[simplify]") {
     params = {};
     params.decimator = "nope";
     CHECK_THROWS_WITH(simplify(scene, params), Catch::Contains("'nope'"));
+    params = {};
+    params.batch = 0;
+    CHECK_THROWS_WITH(simplify(scene, params), Catch::Contains("params.batch"));
     params = {};
     params.untangling.alpha = -1.0;
     CHECK_THROWS_WITH(simplify(scene, params), Catch::Contains("params.alpha"));

@@ -42,6 +42,13 @@ struct SimplifyParams {
     bool global = false;     ///< Untangle the whole scene instead of a box (for comparison).
     std::size_t n_out = 7;   ///< N_out: fixed collar vertices on both sides of a piece.
     UntangleSchedule schedule = UntangleSchedule::Deferred;  ///< See UntangleSchedule.
+    /// Removals that need untangling wait in a batch of up to this many, whose untanglings
+    /// run side by side (TBB) when their regions keep apart by the largest separation a layer
+    /// needs; the batch is committed in order, so the output is the same at any thread count
+    /// (not the same as another batch size). 1: one removal at a time, the paper's order.
+    /// Not used by `global`, nor by the first sweep of the deferred schedule (it untangles
+    /// nothing).
+    std::size_t batch = 16;
     /// Untangling settings. Defaults differ from untangle()'s: rounds of 10 projection steps,
     /// one round per pass, 16 passes. Every pass brings the fields up to date with the moved
     /// vertices (LayerField::update()), and within a pass each layer's own frozen field pulls
@@ -81,11 +88,19 @@ struct SimplifyReport {
     std::size_t refused = 0;         ///< Removals rolled back.
     std::size_t deferred = 0;        ///< Removals set aside (UntangleSchedule::Deferred).
     int rounds = 0;                  ///< Untangling rounds over all calls.
+    /// Untanglings of a batch run once more alone, because their vertices came within reach
+    /// of another job's (or of a removal made while they waited).
+    std::size_t batch_reruns = 0;
+    /// Batches run; untangle_calls / batches is the mean number of jobs per batch.
+    std::size_t batches = 0;
     bool targets_met = true;         ///< Every layer reached its target.
     // Final exact check of the whole output (check_scene()).
     std::size_t crossings = 0, self_crossings = 0, nesting_violations = 0;
     double min_separation_ratio = 0.0;  ///< +inf when nothing is required.
     bool collision_free = false;
+    /// Time per phase (s). The untangling phases (fields, untangle, and the check inside an
+    /// untangling) are summed over the untanglings, which run side by side in batches: with
+    /// several threads their sum can exceed seconds_total.
     double seconds_decimate = 0.0, seconds_fields = 0.0, seconds_untangle = 0.0,
            seconds_check = 0.0, seconds_total = 0.0;
 };
