@@ -89,7 +89,7 @@ struct SceneFilter {
     double remove = 0.0;                                            // 0: 0.8, 0.9, 0.95
     std::string backend;                                            // "": indexed and grid
     std::string schedule;                                           // "": deferred and immediate
-    std::size_t batch = 0;                                          // 0: SimplifyParams' default
+    std::vector<std::size_t> batches{0};  // each strata run at each; 0: SimplifyParams' default
     std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
 };
 
@@ -102,12 +102,15 @@ double max_hausdorff(const SimplifyReport& report) {
 void scenes(const SceneFilter& filter) {
     // strata s and naive s: whole simplify() calls, final exact check and Hausdorff included;
     // loop us/step: the removal loop alone (SimplifyReport::seconds_total) per kept removal.
-    // thr: worker threads (0: every core); jobs/b: untanglings per batch (run side by side).
+    // batch: SimplifyParams::batch; thr: worker threads (0: every core); jobs/b: untanglings
+    // per batch run (side by side); fields / untangle / check s: SimplifyReport's phase times,
+    // summed over the untanglings (which run side by side: with threads, more than the wall).
     std::printf(
-        "%-6s %-7s %-5s %-8s %-9s %3s %8s %9s %7s %8s %8s %8s %8s %7s %6s %5s %7s %9s %9s %6s\n",
-        "layers", "pts", "rm", "backend", "schedule", "thr", "naive s", "strata s", "ratio",
+        "%-6s %-7s %-5s %-8s %-9s %5s %3s %8s %9s %7s %8s %8s %8s %8s %7s %6s %5s %7s %9s %9s %6s "
+        "%8s %9s %8s\n",
+        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "naive s", "strata s", "ratio",
         "us/step", "loop us", "deferred", "refused", "untangl", "jobs/b", "cross", "gap/req",
-        "H naive", "H strata", "rss MB");
+        "H naive", "H strata", "rss MB", "fields s", "untangle s", "check s");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
         for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
             if (filter.layers != 0 && count != filter.layers) continue;
@@ -144,8 +147,11 @@ void scenes(const SceneFilter& filter) {
                         params.untangle = true;
                         params.schedule = schedule;
                         params.untangling.field.backend = backend;
-                        if (filter.batch > 0) params.batch = filter.batch;
-                        for (std::size_t threads : filter.threads) {
+                        for (std::size_t run = 0;
+                             run < filter.batches.size() * filter.threads.size(); ++run) {
+                            const std::size_t batch = filter.batches[run / filter.threads.size()];
+                            const std::size_t threads = filter.threads[run % filter.threads.size()];
+                            params.batch = batch > 0 ? batch : SimplifyParams{}.batch;
                             std::optional<tbb::global_control> limit;
                             if (threads > 0)
                                 limit.emplace(tbb::global_control::max_allowed_parallelism,
@@ -155,9 +161,11 @@ void scenes(const SceneFilter& filter) {
                             const SimplifyReport r = simplify(s, params);
                             const double ts = now() - t;
                             std::printf(
-                                "%-6zu %-7zu %-5.2f %-8s %-9s %3zu %8.3f %9.3f %7.1f %8.2f %8.2f "
-                                "%8zu %8zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f %6ld\n",
-                                count, points, remove, name.c_str(), when.c_str(), threads, tn,
+                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %8.3f %9.3f %7.1f %8.2f %8.2f "
+                                "%8zu %8zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f %6ld %8.3f %9.3f "
+                                "%8.3f\n",
+                                count, points, remove, name.c_str(), when.c_str(), params.batch,
+                                threads, tn,
                                 ts, ts / tn, 1e6 * ts / static_cast<double>(r.removed),
                                 1e6 * r.seconds_total / static_cast<double>(r.removed),
                                 r.deferred, r.refused, r.untangle_calls,
@@ -165,12 +173,24 @@ void scenes(const SceneFilter& filter) {
                                                 static_cast<double>(r.batches)
                                           : 0.0,
                                 r.crossings, r.min_separation_ratio, max_hausdorff(rn),
-                                max_hausdorff(r), peak_rss_mb());
+                                max_hausdorff(r), peak_rss_mb(), r.seconds_fields,
+                                r.seconds_untangle, r.seconds_check);
                             std::fflush(stdout);
                         }
                     }
             }
         }
+}
+
+// "1,2" -> {1, 2}.
+std::vector<std::size_t> numbers(const std::string& list) {
+    std::vector<std::size_t> out;
+    for (std::size_t at = 0; at < list.size();) {
+        const std::size_t comma = std::min(list.find(',', at), list.size());
+        out.push_back(std::strtoul(list.substr(at, comma - at).c_str(), nullptr, 10));
+        at = comma + 1;
+    }
+    return out;
 }
 
 }  // namespace
@@ -191,16 +211,10 @@ int main(int argc, char** argv) {
                 filter.layers = std::strtoul(value.c_str(), nullptr, 10);
             } else if (key == "--remove") {
                 filter.remove = std::strtod(value.c_str(), nullptr);
-            } else if (key == "--threads") {  // a list: 1,2
-                filter.threads.clear();
-                for (std::size_t at = 0; at < value.size();) {
-                    const std::size_t comma = std::min(value.find(',', at), value.size());
-                    filter.threads.push_back(
-                        std::strtoul(value.substr(at, comma - at).c_str(), nullptr, 10));
-                    at = comma + 1;
-                }
+            } else if (key == "--threads") {
+                filter.threads = numbers(value);
             } else if (key == "--batch") {
-                filter.batch = std::strtoul(value.c_str(), nullptr, 10);
+                filter.batches = numbers(value);
             } else if (key == "--schedule") {
                 filter.schedule = value;
             } else if (key == "--backend") {
@@ -215,7 +229,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
-                     "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N]\n");
+                     "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]]\n");
         return 2;
     }
     return 0;

@@ -40,7 +40,10 @@ class SegmentGrid {
   public:
     explicit SegmentGrid(double cell) : cell_(cell) {}
     double cell() const { return cell_; }
-    void clear() { cells_.clear(); }
+    /// Empties every cell, keeping the cells and their capacity for the next fill.
+    void clear() {
+        for (auto& cell : cells_) cell.second.clear();
+    }
 
     void insert(SegRef s, const Box2& box) {
         for_cells(box, [&](std::uint64_t key) { cells_[key].push_back(s); });
@@ -347,6 +350,7 @@ class Driver {
         const Job* job = nullptr;
         const Scene* work = nullptr;
         const SegmentGrid* moving = nullptr;  // the job's moving segments where they are now
+        std::vector<SegRef>* found = nullptr;  // the job's scratch for near()
     };
 
     Vec2 pos(std::size_t k, std::size_t x, const Overlay& ov) const {
@@ -367,7 +371,8 @@ class Driver {
             segments_near(box, f);
             return;
         }
-        std::vector<SegRef> found;
+        std::vector<SegRef>& found = *ov.found;
+        found.clear();
         grid_.query(box, [&](SegRef s) {  // the grid holds the moving ones where they were
             if (!is_free(s.layer, s.start, *ov.job) &&
                 !is_free(s.layer, layers_[s.layer].next[s.start], *ov.job))
@@ -716,8 +721,9 @@ class Driver {
     // Reads the driver's state and writes only to `job`: jobs of one batch run side by side.
     void execute(Job& job) {
         SegmentGrid moving(grid_.cell());
+        std::vector<SegRef> found;
         auto is_ok = [&](const Scene& s) {
-            const Overlay ov{&job, &s, &moving};
+            const Overlay ov{&job, &s, &moving, &found};
             moving.clear();
             for (const SegRef& seg : job.moving) {
                 Box2 box;
