@@ -775,13 +775,15 @@ class Driver {
         report_.seconds_untangle += job.result.seconds_untangle;
         report_.seconds_check += job.result.seconds_check;
         if (!job.result.ok) return false;
-        push(job.l, job.a);
-        push(job.l, job.b);
         for (std::size_t r = 0; r < job.runs.size(); ++r) {
             const Run& run = job.runs[r];
             for (std::size_t k = 0; k < run.ids.size(); ++k)
-                if (job.pieces[r].is_free[k]) move(run.layer, run.ids[k], job.work->layer(r).points[k]);
+                if (job.pieces[r].is_free[k])
+                    move(run.layer, run.ids[k], job.work->layer(r).points[k]);
         }
+        // New costs around the removal and the moved vertices.
+        push(job.l, job.a);
+        push(job.l, job.b);
         for (std::size_t r = 0; r < job.runs.size(); ++r) {
             const Run& run = job.runs[r];
             const WorkLayer& o = layers_[run.layer];
