@@ -166,6 +166,21 @@ TEST_CASE("untanglings batched or one at a time give collision-free results", "[
     }
 }
 
+TEST_CASE("global untangling (for comparison) gives collision-free results", "[simplify]") {
+    // Every untangling works on every vertex of every layer, one at a time (no batches).
+    const Scene input = stack(5, 120, false);
+    SimplifyParams params;
+    params.decimator = "random";
+    params.remove = 0.9;
+    params.schedule = UntangleSchedule::Immediate;
+    params.global = true;
+    Scene out = input;
+    const SimplifyReport r = simplify(out, params);
+    require_valid(input, out, r, params.untangling.separation_tolerance);
+    CHECK(r.untangle_calls > 0);
+    CHECK(r.batches == r.untangle_calls);
+}
+
 TEST_CASE("several seeds of random decimation", "[simplify]") {
     const Scene input = stack(5, 300, false);
     for (std::uint64_t seed : {1u, 2u, 5u}) {
