@@ -70,6 +70,14 @@ void require_valid(const Scene& input, const Scene& out, const SimplifyReport& r
     }
 }
 
+// Simplifies a copy of `input` with `params`, checks the invariants, returns the report.
+SimplifyReport simplify_valid(const Scene& input, const SimplifyParams& params) {
+    Scene out = input;
+    const SimplifyReport r = simplify(out, params);
+    require_valid(input, out, r, params.untangling.separation_tolerance);
+    return r;
+}
+
 }  // namespace
 
 TEST_CASE("generated stacks simplify without collisions, naive decimation collides (slow)",
@@ -86,9 +94,7 @@ TEST_CASE("generated stacks simplify without collisions, naive decimation collid
                     params.decimator = decimator;
                     params.remove = remove;
                     params.seed = 3;
-                    Scene out = input;
-                    const SimplifyReport r = simplify(out, params);
-                    require_valid(input, out, r, params.untangling.separation_tolerance);
+                    const SimplifyReport r = simplify_valid(input, params);
                     if (std::string(decimator) == "random") {
                         SimplifyParams naive = params;
                         naive.untangle = false;
@@ -108,25 +114,19 @@ TEST_CASE("both untangle schedules give collision-free results", "[simplify]") {
     params.decimator = "random";
     params.remove = 0.95;
     SECTION("deferred: conflicts wait, and the second sweep untangles what the targets need") {
-        Scene out = input;
-        const SimplifyReport r = simplify(out, params);
-        require_valid(input, out, r, params.untangling.separation_tolerance);
+        const SimplifyReport r = simplify_valid(input, params);
         CHECK(r.deferred > 0);
     }
     SECTION("deferred, with a target only untangling reaches") {
         params.keep = 6;
-        Scene out = input;
-        const SimplifyReport r = simplify(out, params);
-        require_valid(input, out, r, params.untangling.separation_tolerance);
+        const SimplifyReport r = simplify_valid(input, params);
         CHECK(r.deferred > 0);
         CHECK(r.untangle_calls > 0);
         CHECK(r.untangle_calls > r.refused);  // some of them succeeded
     }
     SECTION("immediate: every conflict is untangled on the spot") {
         params.schedule = UntangleSchedule::Immediate;
-        Scene out = input;
-        const SimplifyReport r = simplify(out, params);
-        require_valid(input, out, r, params.untangling.separation_tolerance);
+        const SimplifyReport r = simplify_valid(input, params);
         CHECK(r.deferred == 0);
         CHECK(r.untangle_calls > r.refused);
     }
@@ -140,18 +140,14 @@ TEST_CASE("untanglings batched or one at a time give collision-free results", "[
     params.schedule = UntangleSchedule::Immediate;
     SECTION("one at a time: the paper's order, one job per batch") {
         params.batch = 1;
-        Scene out = input;
-        const SimplifyReport r = simplify(out, params);
-        require_valid(input, out, r, params.untangling.separation_tolerance);
+        const SimplifyReport r = simplify_valid(input, params);
         CHECK(r.untangle_calls > 10);
         CHECK(r.batches == r.untangle_calls);
         CHECK(r.batch_reruns == 0);
     }
     SECTION("batched: several jobs per batch") {
         params.batch = 16;
-        Scene out = input;
-        const SimplifyReport r = simplify(out, params);
-        require_valid(input, out, r, params.untangling.separation_tolerance);
+        const SimplifyReport r = simplify_valid(input, params);
         CHECK(r.untangle_calls > 10);
         CHECK(r.untangle_calls > r.batches);
         // Untangling moved kept vertices; the report says how far.
@@ -174,9 +170,7 @@ TEST_CASE("global untangling (for comparison) gives collision-free results", "[s
     params.remove = 0.9;
     params.schedule = UntangleSchedule::Immediate;
     params.global = true;
-    Scene out = input;
-    const SimplifyReport r = simplify(out, params);
-    require_valid(input, out, r, params.untangling.separation_tolerance);
+    const SimplifyReport r = simplify_valid(input, params);
     CHECK(r.untangle_calls > 0);
     CHECK(r.batches == r.untangle_calls);
 }
@@ -188,9 +182,7 @@ TEST_CASE("several seeds of random decimation", "[simplify]") {
         SimplifyParams params;
         params.decimator = "random";
         params.seed = seed;
-        Scene out = input;
-        const SimplifyReport r = simplify(out, params);
-        require_valid(input, out, r, params.untangling.separation_tolerance);
+        simplify_valid(input, params);
     }
 }
 
@@ -250,9 +242,7 @@ TEST_CASE("every real slice simplifies without collisions (slow)", "[simplify][s
                 SimplifyParams params;
                 params.decimator = decimator;
                 params.remove = remove;
-                Scene out = input;
-                const SimplifyReport r = simplify(out, params);
-                require_valid(input, out, r, params.untangling.separation_tolerance);
+                simplify_valid(input, params);
             }
         }
     }
