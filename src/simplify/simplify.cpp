@@ -571,6 +571,15 @@ class Driver {
         }
     }
 
+    // The exact local test of removing the vertex at `removed` between a and b (unlinked):
+    // layer l stays valid, the closed triangle (a, removed, b) holds no other vertex, and the
+    // chord (a, b) meets nothing and keeps its separations.
+    bool removal_clear(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
+                       const Overlay& ov) {
+        return closed_valid(l, ov) && triangle_empty(l, a, removed, b, ov) &&
+               segment_clear(l, a, b, ov);
+    }
+
     // Unlinks v; true when that alone keeps its region collision-free.
     bool remove_if_clear(std::size_t l, std::size_t v) {
         WorkLayer& w = layers_[l];
@@ -578,10 +587,7 @@ class Driver {
         const Vec2 removed = w.pos[v];
         const auto start = Clock::now();
         unlink(l, v);
-        const Overlay driver;
-        const bool clear = !params_.untangle ||
-                           (closed_valid(l, driver) && triangle_empty(l, a, removed, b, driver) &&
-                            segment_clear(l, a, b, driver));
+        const bool clear = !params_.untangle || removal_clear(l, a, removed, b, Overlay{});
         report_.seconds_check += seconds_since(start);
         if (clear) {
             push(l, a);
@@ -771,10 +777,7 @@ class Driver {
                 box.extend(pos(seg.layer, layers_[seg.layer].next[seg.start], ov));
                 moving.insert(seg, box);
             }
-            const std::size_t l = job.l;
-            if (!closed_valid(l, ov) || !triangle_empty(l, job.a, job.removed, job.b, ov) ||
-                !segment_clear(l, job.a, job.b, ov))
-                return false;
+            if (!removal_clear(job.l, job.a, job.removed, job.b, ov)) return false;
             for (std::size_t r = 0; r < job.runs.size(); ++r) {
                 const Run& run = job.runs[r];
                 const WorkLayer& o = layers_[run.layer];
@@ -798,17 +801,32 @@ class Driver {
     }
 
     // The box of the job's vertices before and after, and of the removed vertex.
-    Box2 reach_of(const Job& job) const {
+    Box2 span_of(const Job& job) const {
         Box2 box = job.footprint;
         for (std::size_t r = 0; r < job.runs.size(); ++r)
             for (const Vec2& p : job.work->layer(r).points) box.extend(p);
         return box;
     }
 
+    // One untangling of a removal on layer l, in the report.
+    void count_call(std::size_t l) {
+        ++report_.untangle_calls;
+        ++report_.layers[l].untangled;
+    }
+
+    // The removal of v (unlinked) is kept, or rolled back and its vertex locked.
+    void conclude(std::size_t l, std::size_t v, bool kept) {
+        if (kept) {
+            count(Outcome::Removed, l, v);
+            return;
+        }
+        relink(l, v);
+        count(Outcome::Refused, l, v);
+    }
+
     // Applies a successful job's moves; true if it succeeded.
     bool commit(const Job& job) {
-        ++report_.untangle_calls;
-        ++report_.layers[job.l].untangled;
+        count_call(job.l);
         report_.rounds += job.result.rounds;
         report_.seconds_check += job.seconds_prepare;
         report_.seconds_fields += job.result.seconds_fields;
@@ -853,8 +871,7 @@ class Driver {
         ++report_.batches;  // a batch of one
         Job job = job_for(layers_[l], l, v);
         if (prepare(job) != Prepared::Ready) {  // no job waits: never a conflict
-            ++report_.untangle_calls;
-            ++report_.layers[l].untangled;
+            count_call(l);
             return false;
         }
         execute(job);
@@ -891,10 +908,8 @@ class Driver {
             return;
         }
         if (prepared == Prepared::Refused) {
-            ++report_.untangle_calls;
-            ++report_.layers[l].untangled;
-            relink(l, v);
-            count(Outcome::Refused, l, v);
+            count_call(l);
+            conclude(l, v, false);
             return;
         }
         pending_.push_back(std::move(job));
@@ -926,7 +941,7 @@ class Driver {
         std::vector<Job> jobs = std::move(pending_);
         pending_.clear();
         std::vector<Box2> reached(jobs.size());
-        for (std::size_t i = 0; i < jobs.size(); ++i) reached[i] = reach_of(jobs[i]);
+        for (std::size_t i = 0; i < jobs.size(); ++i) reached[i] = span_of(jobs[i]);
         std::vector<std::size_t> again;
         for (std::size_t i = 0; i < jobs.size(); ++i) {
             const Box2 mine = reached[i].inflated(max_reach_);
@@ -939,13 +954,7 @@ class Driver {
                 again.push_back(i);
                 continue;
             }
-            const Job& job = jobs[i];
-            if (commit(job)) {
-                count(Outcome::Removed, job.l, job.v);
-            } else {
-                relink(job.l, job.v);
-                count(Outcome::Refused, job.l, job.v);
-            }
+            conclude(jobs[i].l, jobs[i].v, commit(jobs[i]));
         }
         touched_.clear();
         for (const Candidate& c : postponed_) queue_.push(c);
@@ -956,12 +965,7 @@ class Driver {
             report_.seconds_untangle += job.result.seconds_untangle;
             report_.seconds_check += job.result.seconds_check + job.seconds_prepare;
             ++report_.batch_reruns;
-            if (untangle_now(job.l, job.v)) {
-                count(Outcome::Removed, job.l, job.v);
-            } else {
-                relink(job.l, job.v);
-                count(Outcome::Refused, job.l, job.v);
-            }
+            conclude(job.l, job.v, untangle_now(job.l, job.v));
         }
     }
 
