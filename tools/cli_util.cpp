@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <string>
 
 namespace strata::cli {
 
@@ -39,6 +40,21 @@ void check_outputs(const std::vector<std::string>& outputs,
         if (!parent.empty() && !std::filesystem::is_directory(parent))
             throw InvalidInput(out + ": folder '" + parent.string() + "' does not exist");
     }
+}
+
+CLI::Option* add_count_option(CLI::App& cmd, const std::string& name, std::size_t& target,
+                              const std::string& help, std::size_t min) {
+    const CLI::Validator whole(
+        [min](std::string& value) -> std::string {
+            const std::string error =
+                "must be a whole number >= " + std::to_string(min) + " (got " + value + ")";
+            if (value.empty() || value.size() > 18 ||
+                value.find_first_not_of("0123456789") != std::string::npos)
+                return error;
+            return std::stoull(value) < min ? error : std::string();
+        },
+        "UINT>=" + std::to_string(min));
+    return cmd.add_option(name, target, help)->check(whole)->capture_default_str();
 }
 
 void add_backend_option(CLI::App& cmd, FieldBackend& backend) {

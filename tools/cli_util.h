@@ -43,6 +43,12 @@ CLI::Option* add_choice_option(CLI::App& cmd, const std::string& name, T& target
         ->default_str(default_name);
 }
 
+/// Adds an option `name` storing a whole number >= `min` in `target`. Anything else (a sign, a
+/// fraction, text, or a value below `min`) is reported as "NAME must be a whole number >= MIN
+/// (got VALUE)"; CLI11's own conversion would wrap "-1" around to 2^64 - 1.
+CLI::Option* add_count_option(CLI::App& cmd, const std::string& name, std::size_t& target,
+                              const std::string& help, std::size_t min = 0);
+
 /// Adds `--backend grid|exact|indexed` bound to `backend`.
 void add_backend_option(CLI::App& cmd, FieldBackend& backend);
 

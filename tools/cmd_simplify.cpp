@@ -275,7 +275,7 @@ Run add_simplify_command(CLI::App& app) {
                     "Output scene (one input), or folder (demo, batch)");
     cmd->add_option("--remove", p.remove, "Fraction of each layer's vertices to remove")
         ->capture_default_str();
-    cmd->add_option("--keep", p.keep, "Vertices to keep per layer (instead of --remove)");
+    add_count_option(*cmd, "--keep", p.keep, "Vertices to keep per layer (instead of --remove)");
     cmd->add_option("--max-error", p.max_error,
                     "Never leave an input vertex farther than this (scene units)");
     CLI::Option* decimator =
@@ -283,12 +283,11 @@ Run add_simplify_command(CLI::App& app) {
                         "random | visvalingam | max-error (demo: random, as in the paper)")
             ->capture_default_str();
     cmd->add_option("--seed", p.seed, "Seed of the random decimator")->capture_default_str();
-    cmd->add_option("--untangle-batch", p.batch,
-                    "Untanglings run side by side when their regions keep apart (1: one at a "
-                    "time, the paper's order)")
-        ->capture_default_str();
-    cmd->add_option("--n-out", p.n_out, "N_out: fixed collar vertices around each piece")
-        ->capture_default_str();
+    add_count_option(*cmd, "--untangle-batch", p.batch,
+                     "Untanglings run side by side when their regions keep apart (1: one at a "
+                     "time, the paper's order)",
+                     1);
+    add_count_option(*cmd, "--n-out", p.n_out, "N_out: fixed collar vertices around each piece");
     static const std::map<std::string, UntangleSchedule> schedules{
         {"deferred", UntangleSchedule::Deferred}, {"immediate", UntangleSchedule::Immediate}};
     add_choice_option(*cmd, "--schedule", p.schedule, schedules,
@@ -318,7 +317,6 @@ Run add_simplify_command(CLI::App& app) {
         SimplifyOptions o = *opt;
         if (o.inputs.empty() && decimator->count() == 0) o.params.decimator = "random";
         if (o.no_shape_matching) o.params.untangling.shape = ShapeMode::None;
-        if (o.params.batch < 1) throw InvalidInput("simplify: --untangle-batch must be >= 1 (got 0)");
         validate(o.params);
         if (o.threads < 0)
             throw InvalidInput("simplify: --threads must be >= 0 (got " +
