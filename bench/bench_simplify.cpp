@@ -91,6 +91,7 @@ struct SceneFilter {
     std::string schedule;                                           // "": deferred and immediate
     std::vector<std::size_t> batches{0};  // each strata run at each; 0: SimplifyParams' default
     std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
+    std::vector<std::size_t> give_up{1};  // give_up_when_stalled off (0) / on (1), each
 };
 
 double max_hausdorff(const SimplifyReport& report) {
@@ -105,12 +106,14 @@ void scenes(const SceneFilter& filter) {
     // batch: SimplifyParams::batch; thr: worker threads (0: every core); jobs/b: untanglings
     // per batch run (side by side); fields / untangle / check s: SimplifyReport's phase times,
     // summed over the untanglings (which run side by side: with threads, more than the wall).
+    // give: UntangleParams::give_up_when_stalled; gave up: refused removals it ended early.
     std::printf(
-        "%-6s %-7s %-5s %-8s %-9s %5s %3s %8s %9s %7s %8s %8s %8s %8s %7s %6s %5s %7s %9s %9s %6s "
-        "%8s %9s %8s\n",
-        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "naive s", "strata s", "ratio",
-        "us/step", "loop us", "deferred", "refused", "untangl", "jobs/b", "cross", "gap/req",
-        "H naive", "H strata", "rss MB", "fields s", "untangle s", "check s");
+        "%-6s %-7s %-5s %-8s %-9s %5s %3s %4s %8s %9s %7s %8s %8s %8s %8s %7s %7s %6s %5s %7s %9s "
+        "%9s %6s %8s %9s %8s\n",
+        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "give", "naive s",
+        "strata s", "ratio", "us/step", "loop us", "deferred", "refused", "gave up", "untangl",
+        "jobs/b", "cross", "gap/req", "H naive", "H strata", "rss MB", "fields s", "untangle s",
+        "check s");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
         for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
             if (filter.layers != 0 && count != filter.layers) continue;
@@ -147,10 +150,12 @@ void scenes(const SceneFilter& filter) {
                         params.untangle = true;
                         params.schedule = schedule;
                         params.untangling.field.backend = backend;
-                        for (std::size_t run = 0;
-                             run < filter.batches.size() * filter.threads.size(); ++run) {
-                            const std::size_t batch = filter.batches[run / filter.threads.size()];
-                            const std::size_t threads = filter.threads[run % filter.threads.size()];
+                        const std::size_t nt = filter.threads.size(), nb = filter.batches.size();
+                        for (std::size_t run = 0; run < filter.give_up.size() * nb * nt; ++run) {
+                            const std::size_t give = filter.give_up[run / (nb * nt)];
+                            const std::size_t batch = filter.batches[(run / nt) % nb];
+                            const std::size_t threads = filter.threads[run % nt];
+                            params.untangling.give_up_when_stalled = give != 0;
                             params.batch = batch > 0 ? batch : SimplifyParams{}.batch;
                             std::optional<tbb::global_control> limit;
                             if (threads > 0)
@@ -161,14 +166,14 @@ void scenes(const SceneFilter& filter) {
                             const SimplifyReport r = simplify(s, params);
                             const double ts = now() - t;
                             std::printf(
-                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %8.3f %9.3f %7.1f %8.2f %8.2f "
-                                "%8zu %8zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f %6ld %8.3f %9.3f "
-                                "%8.3f\n",
+                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %4zu %8.3f %9.3f %7.1f %8.2f "
+                                "%8.2f %8zu %8zu %7zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f %6ld %8.3f "
+                                "%9.3f %8.3f\n",
                                 count, points, remove, name.c_str(), when.c_str(), params.batch,
-                                threads, tn,
+                                threads, give, tn,
                                 ts, ts / tn, 1e6 * ts / static_cast<double>(r.removed),
                                 1e6 * r.seconds_total / static_cast<double>(r.removed),
-                                r.deferred, r.refused, r.untangle_calls,
+                                r.deferred, r.refused, r.gave_up, r.untangle_calls,
                                 r.batches ? static_cast<double>(r.untangle_calls) /
                                                 static_cast<double>(r.batches)
                                           : 0.0,
@@ -215,6 +220,8 @@ int main(int argc, char** argv) {
                 filter.threads = numbers(value);
             } else if (key == "--batch") {
                 filter.batches = numbers(value);
+            } else if (key == "--give-up") {
+                filter.give_up = numbers(value);
             } else if (key == "--schedule") {
                 filter.schedule = value;
             } else if (key == "--backend") {
@@ -229,7 +236,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
-                     "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]]\n");
+                     "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
+                     "[--give-up 0,1]\n");
         return 2;
     }
     return 0;

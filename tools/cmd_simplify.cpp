@@ -57,6 +57,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"removed", r.removed},
                         {"untangle_calls", r.untangle_calls},
                         {"refused", r.refused},
+                        {"gave_up", r.gave_up},
                         {"deferred", r.deferred},
                         {"rounds", r.rounds},
                         {"batches", r.batches},
@@ -106,10 +107,10 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
         r.nesting_violations);
     std::printf(
         "min separation ratio %.4g; max Hausdorff %.4g; removals %zu, set aside %zu, untangled "
-        "%zu in %zu batches, refused %zu; time %.3f s (decimate %.3f, fields %.3f, untangle "
+        "%zu in %zu batches, refused %zu (%zu gave up early); time %.3f s (decimate %.3f, fields %.3f, untangle "
         "%.3f, check %.3f)\n",
         r.min_separation_ratio, max_hausdorff(r), r.removed, r.deferred, r.untangle_calls,
-        r.batches, r.refused, r.seconds_total, r.seconds_decimate, r.seconds_fields, r.seconds_untangle,
+        r.batches, r.refused, r.gave_up, r.seconds_total, r.seconds_decimate, r.seconds_fields, r.seconds_untangle,
         r.seconds_check);
     if (!r.collision_free)
         std::fprintf(

@@ -832,6 +832,7 @@ class Driver {
         report_.seconds_fields += job.result.seconds_fields;
         report_.seconds_untangle += job.result.seconds_untangle;
         report_.seconds_check += job.result.seconds_check;
+        if (job.result.gave_up) ++report_.gave_up;
         if (!job.result.ok) return false;
         for (std::size_t r = 0; r < job.runs.size(); ++r) {
             const Run& run = job.runs[r];

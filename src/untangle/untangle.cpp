@@ -43,6 +43,7 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         report.converged = r.converged;
         report.collision_free = r.ok;
         report.mean_speed = r.mean_speed;
+        report.gave_up = r.gave_up;
         report.seconds_fields = r.seconds_fields;
         report.seconds_untangle = r.seconds_untangle;
         report.seconds_check = r.seconds_check;

@@ -142,6 +142,44 @@ TEST_CASE("local untangling moves nothing outside the box", "[untangle][localize
                 CHECK(scene.layer(l).points[v] == before.layer(l).points[v]);
 }
 
+TEST_CASE("an untangling that cannot finish in its passes gives up early when asked",
+          "[untangle]") {
+    // Two straight layers 0.05 apart that must keep 0.2, with steps clamped to 0.05% of an
+    // edge (0.25 mm here): 16 passes of 10 steps cannot move them 0.15 apart, and the worst
+    // violation falls too slowly for the stall rule's extrapolation.
+    const auto line = [](const char* name, double y) {
+        Layer layer;
+        layer.name = name;
+        layer.thickness = 0.2;
+        for (int i = 0; i <= 8; ++i) layer.points.emplace_back(0.5 * i, y);
+        return layer;
+    };
+    const Scene input({line("lower", 0.0), line("upper", 0.05)});
+    UntangleParams params = exact_params();
+    params.gradient_steps = 10;
+    params.max_rounds = 1;
+    params.max_passes = 16;
+    params.max_step_fraction = 0.0005;
+    Scene all_passes = input;
+    const UntangleReport full = untangle(all_passes, params);
+    CHECK_FALSE(full.collision_free);
+    CHECK_FALSE(full.gave_up);
+    CHECK(full.passes == 16);
+    params.give_up_when_stalled = true;
+    Scene given_up = input;
+    const UntangleReport early = untangle(given_up, params);
+    CHECK_FALSE(early.collision_free);
+    CHECK(early.gave_up);
+    CHECK(early.passes == 5);  // the rule looks from the fifth pass on
+    // With steps of up to 0.2% of an edge the same untangling succeeds (in 8 passes), and the
+    // rule does not give up on it.
+    params.max_step_fraction = 0.002;
+    Scene free_to_move = input;
+    const UntangleReport ok = untangle(free_to_move, params);
+    CHECK(ok.collision_free);
+    CHECK_FALSE(ok.gave_up);
+}
+
 TEST_CASE("naive decimation of real slices is untangled", "[untangle][slices]") {
     for (const char* name : {"mh_elegantsuit01_y+0.50.json", "mh_casualsuit03_y+1.50.json",
                              "cipc_multilayer_y+0.00.json"}) {

@@ -52,6 +52,13 @@ struct UntangleParams {
     double min_separation = 0.0;
     /// Guarantee: a separation passes when gap >= required * (1 - tol). [0, 1).
     double separation_tolerance = 0.1;
+    /// Give up early on an untangling that would not finish in time: from the fifth pass on,
+    /// the worst violation |fhat - f| over the samples of a pass's first projection step,
+    /// extrapolated to the last pass at the geometric mean of its last two rates of decrease,
+    /// would still exceed separation_tolerance x the smallest separation aimed for (what the
+    /// final check tolerates). The untangling then ends as not collision-free. false: every
+    /// pass runs. simplify()'s default_untangling() turns it on (docs/simplify.md).
+    bool give_up_when_stalled = false;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
     /// queries as fast (docs/field.md, README "Benchmarks").
@@ -73,6 +80,7 @@ struct UntangleReport {
     std::size_t moved_vertices = 0;  ///< Vertices that moved by more than 1e-12 * diagonal.
     double max_displacement = 0.0;   ///< Largest distance of a vertex from its start, scene units.
     double mean_speed = 0.0;         ///< Last round's V (Eq. 7), scene units per step.
+    bool gave_up = false;  ///< Ended early by UntangleParams::give_up_when_stalled.
     std::size_t crossings_before = 0, crossings_after = 0;  ///< Between layers (check_scene).
     double min_separation_ratio_after = 0.0;  ///< check_scene's, +inf when nothing is required.
     double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;

@@ -291,6 +291,7 @@ class Pass {
         edge_b_.assign(edges, Vec2(0.0));
         edge_wa_.assign(edges, 0.0);
         edge_wb_.assign(edges, 0.0);
+        violation_.assign(vertices + edges, 0.0);
         tbb::parallel_for(
             tbb::blocked_range<std::size_t>(0, vertices + edges, 4),
             [&](const tbb::blocked_range<std::size_t>& range) {
@@ -306,9 +307,11 @@ class Pass {
                     const std::vector<Vec2>& x = scene.layer(piece.layer).points;
                     const std::size_t k = index - offset[p];
                     if (is_vertex) {
-                        if (piece.is_free[k])
-                            own_[i] =
-                                step_toward_zero(compose_at(piece.layer, x[piece.vertices[k]], s));
+                        if (piece.is_free[k]) {
+                            const Composed c = compose_at(piece.layer, x[piece.vertices[k]], s);
+                            violation_[i] = std::abs(c.fhat - c.f);
+                            own_[i] = step_toward_zero(c);
+                        }
                         continue;
                     }
                     const std::size_t k2 = (k + 1) % piece.vertices.size();
@@ -318,6 +321,7 @@ class Pass {
                     for (double t : s.ts) {
                         const Composed c = compose_at(piece.layer, a + t * (b - a), s);
                         if (!c.is_violated) continue;
+                        violation_[i] = std::max(violation_[i], std::abs(c.fhat - c.f));
                         const Vec2 d = step_toward_zero(c);
                         edge_a_[index] += (1.0 - t) * d;
                         edge_wa_[index] += 1.0 - t;
@@ -373,6 +377,24 @@ class Pass {
         return moved;
     }
 
+    // The largest |fhat - f| over the samples of the last project() (scene units).
+    double max_violation() const {
+        double worst = 0.0;
+        for (double v : violation_) worst = std::max(worst, v);
+        return worst;
+    }
+
+    // The smallest separation aimed for between two constrained work layers (+inf if none).
+    double smallest_separation() const {
+        double smallest = std::numeric_limits<double>::infinity();
+        const std::size_t n = fields_.size();
+        for (std::size_t a = 0; a < n; ++a)
+            for (std::size_t b = 0; b < n; ++b)
+                if (a != b && relation_[a * n + b] != Relation::Same)
+                    smallest = std::min(smallest, separation_[a * n + b]);
+        return smallest;
+    }
+
     void match_shapes(Scene& scene, const std::vector<Piece>& pieces,
                       const std::vector<std::vector<Vec2>>& rest) {
         for (std::size_t p = 0; p < pieces.size(); ++p) {
@@ -406,6 +428,7 @@ class Pass {
     // project(): per vertex and per edge of all pieces, and where each piece's start.
     std::vector<Vec2> own_, edge_a_, edge_b_;
     std::vector<double> edge_wa_, edge_wb_;
+    std::vector<double> violation_;  // per vertex and edge task: largest |fhat - f|
     std::vector<std::size_t> vertex_offset_, edge_offset_;
     std::vector<Relation> relation_;    // n x n, work layers
     std::vector<double> separation_;    // n x n, max(required, min_separation)
@@ -458,6 +481,21 @@ std::vector<std::vector<Vec2>> shapes_of(const Scene& work, const std::vector<Pi
     return shapes;
 }
 
+// UntangleParams::give_up_when_stalled: `worst` holds the worst violation at the first step
+// of every pass so far. True when the last one, extrapolated to the last of `passes` passes at
+// the geometric mean of its last two rates of decrease, stays above `allowed`. Measured on the
+// driver's untanglings (docs/simplify.md): failing ones decrease slowly and level off, the
+// successful ones fall to about `allowed` within a few passes.
+bool is_stalled(const std::vector<double>& worst, int passes, double allowed) {
+    if (worst.size() < 5 || !(allowed > 0.0)) return false;  // from the fifth pass on
+    const std::size_t k = worst.size() - 1;
+    const double now = worst[k], before = worst[k - 1], earlier = worst[k - 2];
+    if (!(before > 0.0) || !(earlier > 0.0)) return false;
+    const double rate = std::sqrt(std::min(1.0, now / before) * std::min(1.0, before / earlier));
+    const double left = static_cast<double>(passes) - 1.0 - static_cast<double>(k);
+    return now * std::pow(rate, std::max(left, 0.0)) > allowed;
+}
+
 }  // namespace
 
 EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params) {
@@ -494,7 +532,8 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     // rebuild and, for the grid, recomputes only the leaves near the moves).
     std::optional<SceneFields> built;
     std::vector<std::vector<Vec2>> built_points;
-    for (int pass = 0; pass < params.max_passes && !result.ok; ++pass) {
+    std::vector<double> worst;  // give_up_when_stalled: worst violation at each pass's start
+    for (int pass = 0; pass < params.max_passes && !result.ok && !result.gave_up; ++pass) {
         ++result.passes;
         start = Clock::now();
         if (!built) {
@@ -543,9 +582,17 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                     result.seconds_check += seconds_since(start);
                     start = Clock::now();
                 }
+                if (params.give_up_when_stalled && round == 0 && s == 0 && !result.ok) {
+                    worst.push_back(engine.max_violation());
+                    if (is_stalled(worst, params.max_passes,
+                                   params.separation_tolerance * engine.smallest_separation())) {
+                        result.gave_up = true;
+                        break;
+                    }
+                }
             }
             ++result.rounds;
-            if (result.ok) break;
+            if (result.ok || result.gave_up) break;
             result.mean_speed = free_vertices ? moved / static_cast<double>(free_vertices) : 0.0;
             if (progress &&
                 !progress("untangle", static_cast<double>(result.rounds) / total_rounds))

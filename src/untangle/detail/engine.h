@@ -48,6 +48,7 @@ struct EngineResult {
     bool converged = false;  ///< The last pass met the tolerance.
     bool ok = false;         ///< is_ok(work) held at the end.
     double mean_speed = 0.0;
+    bool gave_up = false;  ///< Stopped by UntangleParams::give_up_when_stalled.
     double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
 };
 
