@@ -92,6 +92,7 @@ struct SceneFilter {
     std::vector<std::size_t> batches{0};  // each strata run at each; 0: SimplifyParams' default
     std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
     std::vector<std::size_t> give_up{1};  // give_up_when_stalled off (0) / on (1), each
+    std::string decimator = "random";     // the paper's experiments
 };
 
 double max_hausdorff(const SimplifyReport& report) {
@@ -131,7 +132,7 @@ void scenes(const SceneFilter& filter) {
                                                      : std::vector<double>{0.8, 0.9, 0.95};
             for (double remove : removals) {
                 SimplifyParams naive;
-                naive.decimator = "random";
+                naive.decimator = filter.decimator;
                 naive.remove = remove;
                 naive.untangle = false;
                 Scene n = input;
@@ -220,6 +221,8 @@ int main(int argc, char** argv) {
                 filter.threads = numbers(value);
             } else if (key == "--batch") {
                 filter.batches = numbers(value);
+            } else if (key == "--decimator") {
+                filter.decimator = value;
             } else if (key == "--give-up") {
                 filter.give_up = numbers(value);
             } else if (key == "--schedule") {
@@ -237,7 +240,7 @@ int main(int argc, char** argv) {
                      "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
                      "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
-                     "[--give-up 0,1]\n");
+                     "[--give-up 0,1] [--decimator random|visvalingam|max-error]\n");
         return 2;
     }
     return 0;
