@@ -32,6 +32,34 @@ double now() {
         .count();
 }
 
+// `count` closed wavy loops offset outward by `spacing` (innermost first, one implicit stack:
+// each loop inside the next), `points` vertices each, thickness 0.01: the closed counterpart
+// of folded_stack, with the same segment length (about 10/600) and waves 1.5 long whatever
+// the size, so that a removal's neighbourhood is the same at every size.
+Scene wavy_loops(std::size_t count, std::size_t points, double spacing) {
+    constexpr double kPi = 3.14159265358979323846;
+    const double radius = static_cast<double>(points) * (10.0 / 600.0) / (2.0 * kPi);
+    const double waves = std::max(5.0, std::round(2.0 * kPi * radius / 1.5));
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < count; ++k) {
+        Layer layer;
+        layer.name = "loop" + std::to_string(k);
+        layer.closed = true;
+        layer.thickness = 0.01;
+        for (std::size_t i = 0; i < points; ++i) {
+            const double a = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(points);
+            const double r = radius + 0.15 * std::sin(waves * a);
+            const double dr = 0.15 * waves * std::cos(waves * a);
+            const Vec2 tangent(dr * std::cos(a) - r * std::sin(a), dr * std::sin(a) + r * std::cos(a));
+            const Vec2 outward = glm::normalize(Vec2(tangent.y, -tangent.x));
+            layer.points.push_back(Vec2(r * std::cos(a), r * std::sin(a)) +
+                                   spacing * static_cast<double>(k) * outward);
+        }
+        layers.push_back(std::move(layer));
+    }
+    return Scene(std::move(layers));
+}
+
 long peak_rss_mb() {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
@@ -93,6 +121,7 @@ struct SceneFilter {
     std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
     std::vector<std::size_t> give_up{1};  // give_up_when_stalled off (0) / on (1), each
     std::string decimator = "random";     // the paper's experiments
+    bool closed = false;                  // wavy_loops instead of folded_stack
 };
 
 double max_hausdorff(const SimplifyReport& report) {
@@ -119,7 +148,9 @@ void scenes(const SceneFilter& filter) {
         for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
             if (filter.layers != 0 && count != filter.layers) continue;
             const Scene input =
-                folded_stack(count, points, 10.0 * static_cast<double>(points) / 600.0);
+                filter.closed
+                    ? wavy_loops(count, points, count > 6 ? 0.0306 : 0.04)
+                    : folded_stack(count, points, 10.0 * static_cast<double>(points) / 600.0);
             if (!check_scene(input).is_collision_free()) {
                 std::fprintf(stderr,
                              "strata_bench_simplify: the generated %zu x %zu input "
@@ -221,6 +252,8 @@ int main(int argc, char** argv) {
                 filter.threads = numbers(value);
             } else if (key == "--batch") {
                 filter.batches = numbers(value);
+            } else if (key == "--shape") {
+                filter.closed = value == "closed";
             } else if (key == "--decimator") {
                 filter.decimator = value;
             } else if (key == "--give-up") {
@@ -240,7 +273,7 @@ int main(int argc, char** argv) {
                      "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
                      "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
-                     "[--give-up 0,1] [--decimator random|visvalingam|max-error]\n");
+                     "[--give-up 0,1] [--decimator random|visvalingam|max-error] [--shape open|closed]\n");
         return 2;
     }
     return 0;

@@ -217,11 +217,7 @@ Placement placement(const SegmentIndex& index, const Box2& bounds, const Vec2& v
         if (o == 0 && std::min(p.x, q.x) <= v.x && v.x <= std::max(p.x, q.x) &&
             std::min(p.y, q.y) <= v.y && v.y <= std::max(p.y, q.y))
             return Placement::OnBoundary;
-        if (p.y <= v.y) {
-            if (q.y > v.y && o > 0) ++winding;
-        } else if (q.y <= v.y && o < 0) {
-            --winding;
-        }
+        winding += winding_contribution(p, q, v);
     }
     return winding != 0 ? Placement::Inside : Placement::Outside;
 }

@@ -83,6 +83,28 @@ SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0, c
     return SegmentContact::Touch;
 }
 
+int winding_contribution(const Vec2& a, const Vec2& b, const Vec2& p) {
+    if (a.y <= p.y) {
+        if (b.y > p.y && orient2d(a, b, p) > 0) return 1;
+    } else if (b.y <= p.y && orient2d(a, b, p) < 0) {
+        return -1;
+    }
+    return 0;
+}
+
+std::optional<int> winding_change_across(const Vec2& p0, const Vec2& p1, const Vec2& a,
+                                         const Vec2& b) {
+    switch (segment_contact(p0, p1, a, b)) {
+        case SegmentContact::None:
+            return 0;
+        case SegmentContact::Touch:
+            return std::nullopt;
+        case SegmentContact::Proper:
+            break;
+    }
+    return orient2d(a, b, p1) > 0 ? 1 : -1;
+}
+
 Vec2 crossing_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
     const Vec2 d = p1 - p0;
     const Vec2 e = q1 - q0;

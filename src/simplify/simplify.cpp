@@ -475,35 +475,79 @@ class Driver {
         return ok;
     }
 
-    // Winding number of closed layer l around p (exact orientation tests).
-    int winding(std::size_t l, const Vec2& p, const Overlay& ov) const {
-        const WorkLayer& w = layers_[l];
-        int wn = 0;
-        const std::size_t start = w.first();
-        std::size_t i = start;
-        do {
-            const std::size_t j = w.next[i];
-            const Vec2 a = pos(l, i, ov), b = pos(l, j, ov);
-            if (a.y <= p.y) {
-                if (b.y > p.y && orient2d(a, b, p) > 0) ++wn;
-            } else if (b.y <= p.y && orient2d(a, b, p) < 0) {
-                --wn;
+    // The segments of closed layer k that the job changes, as (start, end) pairs: their old
+    // versions (driver's positions) in `olds`, their new ones (the overlay's) in `news`. Those
+    // are the segments next to the job's free vertices of k, and on the removal's own layer
+    // the chord (a, b), whose old version is (a, v) and (v, b).
+    void changed_segments(std::size_t k, const Overlay& ov, std::vector<Vec2>& olds,
+                          std::vector<Vec2>& news) const {
+        const Job& job = *ov.job;
+        const WorkLayer& w = layers_[k];
+        std::vector<std::size_t> starts;
+        for (std::size_t r = 0; r < job.runs.size(); ++r) {
+            if (job.runs[r].layer != k) continue;
+            const std::vector<std::size_t>& ids = job.runs[r].ids;
+            for (std::size_t i = 0; i < ids.size(); ++i) {
+                if (!job.pieces[r].is_free[i]) continue;
+                if (w.prev[ids[i]] != kNone) starts.push_back(w.prev[ids[i]]);
+                if (w.next[ids[i]] != kNone) starts.push_back(ids[i]);
             }
-            i = j;
-        } while (i != start);
-        return wn;
+        }
+        if (k == job.l) starts.push_back(job.a);
+        std::sort(starts.begin(), starts.end());
+        starts.erase(std::unique(starts.begin(), starts.end()), starts.end());
+        olds.clear();
+        news.clear();
+        for (std::size_t s : starts) {
+            const std::size_t t = w.next[s];
+            news.push_back(pos(k, s, ov));
+            news.push_back(pos(k, t, ov));
+            if (k == job.l && s == job.a) {
+                olds.insert(olds.end(), {w.pos[s], job.removed, job.removed, w.pos[t]});
+            } else {
+                olds.insert(olds.end(), {w.pos[s], w.pos[t]});
+            }
+        }
     }
 
-    // Every vertex of `ids` (layer l) is inside the closed layers it is under and outside the
-    // closed layers it is over or beside: moving vertices can carry a whole small loop out of
-    // another without any crossing left at the end.
-    bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids, const Overlay& ov) const {
+    // Every vertex of `ids` (layer l) stays on its side of every closed layer: moving
+    // vertices could carry a whole small loop out of another without any crossing left at
+    // the end. Tested locally and exactly, so that the cost does not grow with the layers:
+    // the change of the winding number of closed layer k around a vertex that moves from p0
+    // to p1 is the change at p0 caused by the segments of k the job changed, plus the
+    // crossings of the path p0 -> p1 with k where it is now (winding_contribution(),
+    // winding_change_across()). Any change, or a path that touches k, fails. The driver's
+    // state before the job is collision-free, so an unchanged side is the right one.
+    bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids, const Overlay& ov) {
+        std::vector<Vec2> olds, news;
         for (std::size_t k = 0; k < layers_.size(); ++k) {
             if (k == l || !layers_[k].closed) continue;
-            const Relation rel = input_.relation(l, k);
+            changed_segments(k, ov, olds, news);
             for (std::size_t id : ids) {
-                const bool inside = winding(k, pos(l, id, ov), ov) != 0;
-                if (inside != (rel == Relation::Under)) return false;
+                const Vec2 p0 = layers_[l].pos[id], p1 = pos(l, id, ov);
+                int change = 0;
+                for (std::size_t i = 0; i < news.size(); i += 2)
+                    change += winding_contribution(news[i], news[i + 1], p0);
+                for (std::size_t i = 0; i < olds.size(); i += 2)
+                    change -= winding_contribution(olds[i], olds[i + 1], p0);
+                if (p1 != p0) {
+                    Box2 path;
+                    path.extend(p0);
+                    path.extend(p1);
+                    bool touches = false;
+                    near(path, ov, [&](std::size_t j, std::size_t u) {
+                        if (j != k || touches) return;
+                        const std::optional<int> across = winding_change_across(
+                            p0, p1, pos(k, u, ov), pos(k, layers_[k].next[u], ov));
+                        if (across) {
+                            change += *across;
+                        } else {
+                            touches = true;
+                        }
+                    });
+                    if (touches) return false;
+                }
+                if (change != 0) return false;
             }
         }
         return true;

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
+#include <vector>
 
 using namespace strata;
 
@@ -117,4 +119,97 @@ TEST_CASE("point_segment_distance", "[predicates]") {
     CHECK(point_segment_distance({1, 1}, {1, 1}, {1, 1}) == 0.0);
     // A point on the segment.
     CHECK(point_segment_distance({0.5, 0.5}, {0, 0}, {1, 1}) == Approx(0.0).margin(1e-16));
+}
+
+namespace {
+
+// Winding number of the closed polyline `k` around p, by winding_contribution().
+int winding_of(const std::vector<Vec2>& k, const Vec2& p) {
+    int w = 0;
+    for (std::size_t i = 0; i < k.size(); ++i) w += winding_contribution(k[i], k[(i + 1) % k.size()], p);
+    return w;
+}
+
+}  // namespace
+
+TEST_CASE("winding_contribution sums to the winding number", "[predicates]") {
+    const std::vector<Vec2> ccw{{0, 0}, {4, 0}, {4, 3}, {0, 3}};
+    const std::vector<Vec2> cw(ccw.rbegin(), ccw.rend());
+    CHECK(winding_of(ccw, {1, 1}) == 1);
+    CHECK(winding_of(cw, {1, 1}) == -1);
+    CHECK(winding_of(ccw, {5, 1}) == 0);
+    CHECK(winding_of(ccw, {-1, 1}) == 0);
+    CHECK(winding_of(ccw, {2, 0.0}) == 1);  // on the bottom edge: half-open rule, counted in
+    CHECK(winding_of(ccw, {2, 3.0}) == 0);  // on the top edge: out
+    // A loop going twice around.
+    const std::vector<Vec2> twice{{0, 0}, {4, 0}, {4, 3}, {0, 3}, {0.5, 0.5}, {3.5, 0.5}, {3.5, 2.5}, {0.5, 2.5}};
+    CHECK(winding_of(twice, {2, 1}) == 2);
+    CHECK(winding_of(twice, {0.2, 1}) == 1);
+}
+
+TEST_CASE("winding_change_across gives the winding change along a path", "[predicates]") {
+    CHECK(winding_change_across({2, 1}, {0, 1}, {1, 0}, {1, 2}) == 1);  // right to left of a->b
+    CHECK(winding_change_across({0, 1}, {2, 1}, {1, 0}, {1, 2}) == -1);
+    CHECK(winding_change_across({0, 1}, {0.5, 1}, {1, 0}, {1, 2}) == 0);
+    CHECK_FALSE(winding_change_across({0, 1}, {1, 1}, {1, 0}, {1, 2}).has_value());  // ends on it
+    CHECK_FALSE(winding_change_across({0, 0}, {2, 0}, {1, 0}, {1, 2}).has_value());  // through a's end
+
+    // The identity the simplification driver's local nesting check relies on: when a stretch
+    // of a closed polyline K0 moves (K1) and a point moves from p0 to p1,
+    //   winding(K1, p1) - winding(K0, p0)
+    //     = sum over the changed segments of [contribution(new, p0) - contribution(old, p0)]
+    //     + sum over the segments of K1 of winding_change_across(p0, p1, segment),
+    // where only the changed segments and those of K1 near the path take part.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    constexpr double kPi = 3.14159265358979323846;
+    int decided = 0, changed = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        const std::size_t n = 12 + static_cast<std::size_t>(trial % 9);
+        std::vector<Vec2> k0;
+        const bool clockwise = trial % 2 == 1;
+        for (std::size_t i = 0; i < n; ++i) {
+            double t = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(n);
+            if (clockwise) t = -t;
+            const double r = 1.0 + 0.3 * u(rng);
+            k0.emplace_back(r * std::cos(t), r * std::sin(t));
+        }
+        // Move a stretch of 1-4 consecutive vertices (and, half the time, drop one of them).
+        std::vector<Vec2> k1 = k0;
+        const std::size_t first = static_cast<std::size_t>(trial) % n;
+        const std::size_t count = 1 + static_cast<std::size_t>(trial / 7) % 4;
+        std::vector<char> moved(n, 0);
+        for (std::size_t c = 0; c < count; ++c) {
+            const std::size_t i = (first + c) % n;
+            k1[i] += 0.6 * Vec2(u(rng), u(rng));
+            moved[i] = 1;
+        }
+        // Changed segments: those with a moved end (old and new versions).
+        int delta = 0;
+        const Vec2 p0(1.2 * u(rng), 1.2 * u(rng));
+        const Vec2 p1 = trial % 3 == 0 ? p0 : p0 + 0.8 * Vec2(u(rng), u(rng));
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t j = (i + 1) % n;
+            if (!moved[i] && !moved[j]) continue;
+            delta += winding_contribution(k1[i], k1[j], p0) - winding_contribution(k0[i], k0[j], p0);
+        }
+        bool degenerate = false;
+        if (p1 != p0)
+            for (std::size_t i = 0; i < n; ++i) {
+                const auto c = winding_change_across(p0, p1, k1[i], k1[(i + 1) % n]);
+                if (!c) {
+                    degenerate = true;
+                    break;
+                }
+                delta += *c;
+            }
+        if (degenerate) continue;
+        ++decided;
+        const int expected = winding_of(k1, p1) - winding_of(k0, p0);
+        if (expected != 0) ++changed;
+        INFO("trial " << trial);
+        REQUIRE(delta == expected);
+    }
+    CHECK(decided > 3900);
+    CHECK(changed > 400);  // the identity is tested where the winding number changes, too
 }

@@ -6,6 +6,8 @@
 
 #include "strata/core/types.h"
 
+#include <optional>
+
 namespace strata {
 
 /// Sign of the area of triangle (a, b, c): +1 counter-clockwise (c left of a->b), -1
@@ -21,6 +23,22 @@ enum class SegmentContact {
 
 /// Exact classification of segments [p0, p1] and [q0, q1].
 SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1);
+
+/// Contribution of the directed segment a -> b to the winding number of a closed polyline
+/// around p, by the crossing rule (the ray from p toward +x; each segment half-open in y):
+/// +1 when the segment goes up across the ray with p on its left, -1 when it goes down across
+/// it with p on its right, 0 otherwise. Summed over the segments of a closed polyline that
+/// does not pass through p: its winding number around p. Exact.
+int winding_contribution(const Vec2& a, const Vec2& b, const Vec2& p);
+
+/// The change of the winding number of a closed polyline around a point that moves along
+/// p0 -> p1, due to the polyline's segment a -> b: +1 when the path crosses it from its right
+/// to its left through the interiors of both, -1 the other way, 0 when they do not meet;
+/// std::nullopt when they touch (an end of one on the other, or a collinear overlap), where
+/// the change is not decided segment by segment. Summed over the polyline's segments (none
+/// nullopt): winding(p1) - winding(p0). Exact.
+std::optional<int> winding_change_across(const Vec2& p0, const Vec2& p1, const Vec2& a,
+                                         const Vec2& b);
 
 /// Intersection point of the supporting lines of two properly crossing segments (rounded).
 Vec2 crossing_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1);
