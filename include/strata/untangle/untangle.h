@@ -55,9 +55,12 @@ struct UntangleParams {
     /// Give up early on an untangling that would not finish in time: from the fifth pass on,
     /// the worst violation |fhat - f| over the samples of a pass's first projection step,
     /// extrapolated to the last pass at the geometric mean of its last two rates of decrease,
-    /// would still exceed separation_tolerance x the smallest separation aimed for (what the
-    /// final check tolerates). The untangling then ends as not collision-free. false: every
-    /// pass runs. simplify()'s default_untangling() turns it on (docs/simplify.md).
+    /// would still exceed what the final check tolerates below the separation aimed for
+    /// (separation_tolerance x the smallest required separation of the constrained pairs).
+    /// Never when a constrained pair requires less than min_separation (zero thickness: only
+    /// crossings fail, and the violation does not tell). The untangling then ends as not
+    /// collision-free. false: every pass runs. simplify()'s default_untangling() turns it on
+    /// (docs/simplify.md).
     bool give_up_when_stalled = false;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers

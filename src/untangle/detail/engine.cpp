@@ -122,6 +122,7 @@ class Pass {
         // chain (every two of different parents nested, none side by side): then a point's
         // members sorted by rank are a chain, composed without the general constraint search.
         const std::size_t n = fields.size();
+        bool gap_free_pair = false;  // a constrained pair that needs no gap (see slack())
         relation_.resize(n * n);
         separation_.resize(n * n);
         layer_weight_.resize(n);
@@ -134,10 +135,19 @@ class Pass {
                 const Relation r = relations.relation(a, b);
                 relation_[a * n + b] = r;
                 separation_[a * n + b] = std::max(relations.separation(a, b), min_separation);
+                // What the final check accepts below the aim: gap >= required * (1 - tol).
+                const double required = relations.separation(a, b);
+                if (r != Relation::Same) {
+                    if (required >= min_separation)
+                        slack_ = std::min(slack_, params.separation_tolerance * required);
+                    else
+                        gap_free_pair = true;
+                }
                 if (r == Relation::Over) ++rank_[a];
                 if (r == Relation::SideBySide) is_chain_ = false;
             }
         }
+        if (gap_free_pair) slack_ = std::numeric_limits<double>::infinity();
     }
 
     // The composed value and gradient of `layer` at x (thread-safe with one Scratch per thread).
@@ -384,16 +394,13 @@ class Pass {
         return worst;
     }
 
-    // The smallest separation aimed for between two constrained work layers (+inf if none).
-    double smallest_separation() const {
-        double smallest = std::numeric_limits<double>::infinity();
-        const std::size_t n = fields_.size();
-        for (std::size_t a = 0; a < n; ++a)
-            for (std::size_t b = 0; b < n; ++b)
-                if (a != b && relation_[a * n + b] != Relation::Same)
-                    smallest = std::min(smallest, separation_[a * n + b]);
-        return smallest;
-    }
+    // give_up_when_stalled's threshold: the smallest slack, over the constrained pairs of
+    // work layers, between the gap aimed for and the gap the final check accepts
+    // (separation_tolerance x required). +inf (never give up) when a constrained pair needs
+    // less than min_separation: only crossings fail there, and the worst violation, a layer's
+    // share of the correction toward min_separation, says little about them (on the real
+    // garment slices, whose thickness is 0, the rule gave up on untanglings that succeed).
+    double slack() const { return slack_; }
 
     void match_shapes(Scene& scene, const std::vector<Piece>& pieces,
                       const std::vector<std::vector<Vec2>>& rest) {
@@ -432,6 +439,7 @@ class Pass {
     std::vector<std::size_t> vertex_offset_, edge_offset_;
     std::vector<Relation> relation_;    // n x n, work layers
     std::vector<double> separation_;    // n x n, max(required, min_separation)
+    double slack_ = std::numeric_limits<double>::infinity();  // see slack()
     std::vector<double> layer_weight_;  // per work layer
     std::vector<std::size_t> rank_;     // layers each is over: innermost 0
     bool is_chain_ = true;
@@ -584,8 +592,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                 }
                 if (params.give_up_when_stalled && round == 0 && s == 0 && !result.ok) {
                     worst.push_back(engine.max_violation());
-                    if (is_stalled(worst, params.max_passes,
-                                   params.separation_tolerance * engine.smallest_separation())) {
+                    if (is_stalled(worst, params.max_passes, engine.slack())) {
                         result.gave_up = true;
                         break;
                     }
