@@ -1,0 +1,53 @@
+#pragma once
+/// @file Internal: uniform buckets over a SegmentStore's slots and the exact nearest-segment
+/// search through them (the ExactIndexed backend; the Grid backend's voxel values and
+/// out-of-band signs).
+
+#include "field/detail/segment_store.h"
+
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+namespace strata::detail {
+
+/// Square buckets of side `cell` (scene units) listing the live slots whose bounding box
+/// touches them. The store is not owned: pass the same one to every call.
+class SegmentIndex {
+  public:
+    explicit SegmentIndex(double cell = 1.0) : cell_(cell) {}
+
+    /// Indexes every live slot of `store` (replaces the current content).
+    void build(const SegmentStore& store);
+    /// Adds / removes one slot (its geometry as it is in the store now / was when inserted).
+    void insert(const SegmentStore& store, std::uint32_t slot);
+    void erase(const SegmentStore& store, std::uint32_t slot);
+
+    /// Rings of buckets around x, clipped to the occupied ones, until no unvisited segment can be
+    /// as near as the best one (ties included, so the winner is the brute-force one), or, when
+    /// nothing within `limit` (scene units) has been found, none can be within `limit` either.
+    void search(const SegmentStore& store, const Vec2& x, Nearest& best,
+                double limit = std::numeric_limits<double>::infinity()) const;
+
+    /// The slots listed in the buckets that `box` touches, sorted, without repeats (`out` is
+    /// replaced): a superset of the segments that have a point in `box`.
+    void candidates(const Box2& box, std::vector<std::uint32_t>& out) const;
+
+    /// Buckets, their slot lists and the hash table's nodes and bucket array, in bytes.
+    std::size_t memory_bytes() const;
+
+  private:
+    long cell_of(double v) const;
+    template <typename F>
+    void for_cells(const Box2& box, F&& f) const;
+    void visit(const SegmentStore& store, const Vec2& x, long i, long j, Nearest& best) const;
+
+    double cell_ = 1.0;
+    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> buckets_;
+    // Bounding range of the buckets ever occupied since the last build (not shrunk by erase).
+    long imin_ = std::numeric_limits<long>::max(), imax_ = std::numeric_limits<long>::min();
+    long jmin_ = std::numeric_limits<long>::max(), jmax_ = std::numeric_limits<long>::min();
+};
+
+}  // namespace strata::detail
