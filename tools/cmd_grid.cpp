@@ -112,7 +112,8 @@ Run add_grid_command(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::Range(16, 16384));
     cmd->add_flag("--info", opt->info,
-                  "Print per layer: active voxels, leaves, memory, bbox, voxel size, band");
+                  "Print per layer: active voxels, leaves, memory (its segments and its share "
+                  "of the shared grid), bbox; then the totals, voxel size, band");
     cmd->add_option("--voxel-size", opt->params.voxel_size,
                     "Voxel size, scene units (0 = auto: median segment / 4, <= half the smallest "
                     "separation)")
@@ -157,6 +158,12 @@ Run add_grid_command(CLI::App& app) {
                           << format_number(st.bounds.max.x) << ", "
                           << format_number(st.bounds.max.y) << "]\n";
             }
+            const FieldStats total = fields.total_stats();
+            std::cout << "all layers (one shared grid): " << total.segments << " segments, "
+                      << total.active_voxels << " active voxels, " << total.leaves << " leaves, "
+                      << total.memory_bytes << " bytes ("
+                      << total.memory_bytes / std::max<std::size_t>(total.segments, 1)
+                      << " per segment)\n";
         }
         return 0;
     };

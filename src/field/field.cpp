@@ -87,8 +87,9 @@ ResolvedFieldParams resolve(const FieldParams& params, const Scene& scene) {
     return out;
 }
 
-std::unique_ptr<LayerField> make_field(const Layer& layer, int outside_sign,
-                                       const ResolvedFieldParams& params) {
+namespace {
+
+void check_field_args(const Layer& layer, int outside_sign, const ResolvedFieldParams& params) {
     if (outside_sign != 1 && outside_sign != -1)
         throw InvalidInput("make_field: outside_sign must be +1 or -1 (got " +
                            std::to_string(outside_sign) + ") for layer '" + layer.name + "'");
@@ -100,6 +101,13 @@ std::unique_ptr<LayerField> make_field(const Layer& layer, int outside_sign,
             "finite and > 0 (got " +
             format_number(params.voxel_size) + ", " + format_number(params.band_width) + ", " +
             format_number(params.bucket_size) + ")");
+}
+
+}  // namespace
+
+std::unique_ptr<LayerField> make_field(const Layer& layer, int outside_sign,
+                                       const ResolvedFieldParams& params) {
+    check_field_args(layer, outside_sign, params);
     switch (params.backend) {
         case FieldBackend::Grid:
             return detail::make_grid_field(layer, outside_sign, params);
@@ -118,15 +126,44 @@ SceneFields::SceneFields(const Scene& scene, const FieldParams& params,
         throw InvalidInput("SceneFields: outside_signs has " +
                            std::to_string(outside_signs.size()) + " entries for " +
                            std::to_string(scene.size()) + " layers");
+    std::vector<int> signs(scene.size(), 1);
+    if (!outside_signs.empty()) signs = outside_signs;
+    if (params_.backend == FieldBackend::Grid) {
+        std::vector<const Layer*> layers;
+        for (std::size_t i = 0; i < scene.size(); ++i) {
+            check_field_args(scene.layer(i), signs[i], params_);
+            layers.push_back(&scene.layer(i));
+        }
+        detail::GridFields grid = detail::make_grid_fields(layers, signs, params_);
+        grid_ = std::move(grid.stack);
+        fields_ = std::move(grid.fields);
+        return;
+    }
     fields_.reserve(scene.size());
     for (std::size_t i = 0; i < scene.size(); ++i)
-        fields_.push_back(
-            make_field(scene.layer(i), outside_signs.empty() ? 1 : outside_signs[i], params_));
+        fields_.push_back(make_field(scene.layer(i), signs[i], params_));
 }
 
 void SceneFields::sample_all(const Vec2& x, std::vector<FieldSample>& out) const {
+    if (grid_) {
+        detail::grid_sample_all(*grid_, x, out);
+        return;
+    }
     out.resize(fields_.size());
     for (std::size_t i = 0; i < fields_.size(); ++i) out[i] = fields_[i]->sample(x);
+}
+
+FieldStats SceneFields::total_stats() const {
+    if (grid_) return detail::grid_total_stats(*grid_);
+    FieldStats total;
+    for (const auto& field : fields_) {
+        const FieldStats st = field->stats();
+        total.segments += st.segments;
+        total.memory_bytes += st.memory_bytes;
+        total.bounds.extend(st.bounds);
+    }
+    total.band_width = params_.band_width;
+    return total;
 }
 
 }  // namespace strata

@@ -1,10 +1,13 @@
-// Grid backend: one OpenVDB FloatGrid per layer, a 2D slab at index z = 0 with the transform
-// createLinearTransform(h), band voxels holding the exact signed values, inactive voxels the
-// band width with the right sign. The only translation unit of the field module that includes
-// OpenVDB (it also writes .vdb files).
+// Grid backend: the layers of a scene share one OpenVDB FloatGrid, layer i at index z = i
+// (layers 8k..8k+7 in the k-th row of leaves along z), with the transform
+// createLinearTransform(h). In every leaf, layer i's band voxels hold its exact signed values and
+// its other voxels the band width with layer i's sign. Points whose bilinear corners fall in no
+// leaf take layer i's sign from the first leaf voxel of its plane along +x. The only translation
+// unit of the field module that includes OpenVDB (it also writes .vdb files).
 
 #include "field/detail/backends.h"
 #include "field/detail/grid_inspect.h"
+#include "field/detail/segment_index.h"
 #include "field/detail/segment_store.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"
@@ -13,7 +16,6 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
-#include <openvdb/tools/Prune.h>
 #include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -22,9 +24,10 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <system_error>
-#include <unordered_map>
+#include <utility>
 
 namespace strata::detail {
 
@@ -36,11 +39,13 @@ using ConstAccessor = openvdb::tree::ValueAccessor<const Tree, false>;
 using N2 = Tree::RootNodeType::ChildNodeType;  // 4096^3 voxels
 using N1 = N2::ChildNodeType;                  // 128^3 voxels
 
-constexpr int kLeafDim = 8;                 // voxels per leaf side
-constexpr double kMaxIndex = 1073741824.0;  // 2^30: voxel coordinates stay in int32
+constexpr int kLeafDim = 8;                  // voxels per leaf side; layers per leaf row
+constexpr int kPlane = kLeafDim * kLeafDim;  // voxels of one z plane of a leaf
+constexpr double kMaxIndex = 1073741824.0;   // 2^30: voxel coordinates stay in int32
+constexpr std::uint64_t kPlaneBits = 0x0101010101010101ull;  // z = 0 bits of a mask word
 
-long floor_div8(long v) {
-    return v >= 0 ? v / kLeafDim : -((-v + kLeafDim - 1) / kLeafDim);
+long floor_div(long v, long d) {
+    return v >= 0 ? v / d : -((-v + d - 1) / d);
 }
 
 std::uint64_t leaf_key(long i, long j) {
@@ -54,131 +59,233 @@ long key_j(std::uint64_t k) {
     return static_cast<std::int32_t>(static_cast<std::uint32_t>(k & 0xffffffffu));
 }
 
-class GridField final : public LayerField {
+/// Offset in a leaf of voxel (vx, vy) of the plane z (any z: its position in the leaf row).
+openvdb::Index voxel_offset(int vx, int vy, int z) {
+    return static_cast<openvdb::Index>((vx << 6) | (vy << 3) | (z & (kLeafDim - 1)));
+}
+
+/// Number of active voxels of plane z in `leaf`.
+std::size_t plane_active_count(const Leaf& leaf, int z) {
+    std::size_t count = 0;
+    const std::uint64_t bits = kPlaneBits << (z & (kLeafDim - 1));
+    for (openvdb::Index w = 0; w < 8; ++w)
+        count += static_cast<std::size_t>(
+            __builtin_popcountll(leaf.getValueMask().getWord<std::uint64_t>(w) & bits));
+    return count;
+}
+
+/// True when a plane other than z of `leaf` has an active voxel.
+bool other_planes_active(const Leaf& leaf, int z) {
+    const std::uint64_t others = ~(kPlaneBits << (z & (kLeafDim - 1)));
+    for (openvdb::Index w = 0; w < 8; ++w)
+        if ((leaf.getValueMask().getWord<std::uint64_t>(w) & others) != 0) return true;
+    return false;
+}
+
+/// The bilinear interpolant of the 4 corner values (00, 10, 01, 11) at (fx, fy) in [0, 1]^2,
+/// in double, and its gradient; every sampling path goes through here.
+FieldSample bilinear(const float (&v)[4], double fx, double fy, double h) {
+    FieldSample out;
+    const double d00 = v[0], d10 = v[1], d01 = v[2], d11 = v[3];
+    out.value = (1.0 - fy) * ((1.0 - fx) * d00 + fx * d10) + fy * ((1.0 - fx) * d01 + fx * d11);
+    out.gradient = Vec2(((1.0 - fy) * (d10 - d00) + fy * (d11 - d01)) / h,
+                        ((1.0 - fx) * (d01 - d00) + fx * (d11 - d10)) / h);
+    return out;
+}
+
+}  // namespace
+
+/// @brief The layer-stacked grid of a scene and the segments of every layer.
+/// Invariants (a full build establishes them, update() keeps them):
+/// - the leaf of row r (z in [8r, 8r + 8)) at (li, lj) exists iff a layer of that row has a band
+///   voxel (voxel centre within band_width of the layer) in it;
+/// - in an existing leaf, plane z = i holds layer i's plane: if layer i has band voxels there,
+///   their exact values (active) and +-band with the sign spread from the 4-neighbours
+///   elsewhere; if not, +-band (inactive) with the sign of layer i at the leaf's origin voxel for
+///   closed layers (exact nearest-segment search), +band for open layers;
+/// - planes of a row beyond the last layer, and every tile, hold the background +band;
+/// - internal nodes without children are tiles, so the tree equals a fresh build's.
+/// Each plane depends only on its layer and its leaf, so updating one layer's planes where its
+/// geometry changed equals a rebuild.
+class GridStack {
   public:
-    GridField(const Layer& layer, int outside_sign, const ResolvedFieldParams& params)
-        : LayerField(layer.name, layer.closed, outside_sign),
-          h_(params.voxel_size),
-          band_(params.band_width) {
-        check_points(layer.points, layer.closed, "make_field");
-        check_extent(layer.points, 0, layer.points.size());
-        store_.build(layer.points, layer.closed, outside_sign);
-        set_outside_sign(store_.outside_sign());
-        rebuild();
+    GridStack(const std::vector<const Layer*>& layers, const std::vector<int>& outside_signs,
+              const ResolvedFieldParams& params)
+        : h_(params.voxel_size), band_(params.band_width) {
+        layers_.reserve(layers.size());
+        for (std::size_t l = 0; l < layers.size(); ++l) {
+            const Layer& layer = *layers[l];
+            check_points(layer.points, layer.closed, "make_field");
+            check_extent(layer.name, layer.points, 0, layer.points.size());
+            LayerData& d = layers_.emplace_back(params.bucket_size);
+            d.name = layer.name;
+            d.closed = layer.closed;
+            d.store.build(layer.points, layer.closed, outside_signs[l]);
+            d.index.build(d.store);
+        }
+        build();
     }
 
-    FieldSample sample(const Vec2& x) const override {
+    std::size_t size() const { return layers_.size(); }
+    const std::string& name(std::size_t l) const { return layers_[l].name; }
+    bool is_closed(std::size_t l) const { return layers_[l].closed; }
+    int outside_sign(std::size_t l) const { return layers_[l].store.outside_sign(); }
+    double voxel_size() const { return h_; }
+    const Tree& tree() const { return grid_->tree(); }
+
+    FieldSample sample(std::size_t l, const Vec2& x) const {
         FieldSample out;
-        out.border = store_.border(x);
-        const double gx = x.x / h_, gy = x.y / h_;
-        if (!(std::abs(gx) < kMaxIndex && std::abs(gy) < kMaxIndex)) {
-            out.value = static_cast<double>(grid_->tree().background());
-            return out;
+        int i0 = 0, j0 = 0;
+        double fx = 0.0, fy = 0.0;
+        if (!cell_of(x, i0, j0, fx, fy)) {
+            out.value = band_;
+        } else {
+            ConstAccessor acc(tree());
+            const int z = static_cast<int>(l);
+            const Leaf* leaf[4];
+            probe_corners(acc, i0, j0, z, leaf);
+            float v[4];
+            const bool on = read_corners(acc, leaf, i0, j0, z, v);
+            out = bilinear(v, fx, fy, h_);
+            out.in_band = on;
         }
-        const double fx0 = std::floor(gx), fy0 = std::floor(gy);
-        const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
-        const double fx = gx - fx0, fy = gy - fy0;
-        ConstAccessor acc(grid_->tree());
-        float v00 = 0.f, v10 = 0.f, v01 = 0.f, v11 = 0.f;
-        const bool a00 = acc.probeValue(openvdb::Coord(i0, j0, 0), v00);
-        const bool a10 = acc.probeValue(openvdb::Coord(i0 + 1, j0, 0), v10);
-        const bool a01 = acc.probeValue(openvdb::Coord(i0, j0 + 1, 0), v01);
-        const bool a11 = acc.probeValue(openvdb::Coord(i0 + 1, j0 + 1, 0), v11);
-        const double d00 = v00, d10 = v10, d01 = v01, d11 = v11;
-        out.value = (1.0 - fy) * ((1.0 - fx) * d00 + fx * d10) + fy * ((1.0 - fx) * d01 + fx * d11);
-        out.gradient = Vec2(((1.0 - fy) * (d10 - d00) + fy * (d11 - d01)) / h_,
-                            ((1.0 - fx) * (d01 - d00) + fx * (d11 - d10)) / h_);
-        out.in_band = a00 && a10 && a01 && a11;
+        out.border = layers_[l].store.border(x);
         return out;
     }
 
-    void update(const std::vector<Vec2>& points, const PolylineEdit& edit) override {
+    // Stops at the first corner out of the band: no walk through the tiles.
+    FieldSample sample_in_band(std::size_t l, const Vec2& x) const {
+        FieldSample out;
+        int i0 = 0, j0 = 0;
+        double fx = 0.0, fy = 0.0;
+        if (!cell_of(x, i0, j0, fx, fy)) return out;
+        ConstAccessor acc(tree());
+        const int z = static_cast<int>(l);
+        float v[4];
+        for (int c = 0; c < 4; ++c) {
+            const openvdb::Coord xyz(i0 + (c & 1), j0 + (c >> 1), z);
+            const Leaf* leaf = acc.probeConstLeaf(xyz);
+            if (leaf == nullptr) return out;
+            const openvdb::Index n = Leaf::coordToOffset(xyz);
+            if (!leaf->isValueOn(n)) return out;
+            v[c] = leaf->getValue(n);
+        }
+        out = bilinear(v, fx, fy, h_);
+        out.in_band = true;
+        out.border = layers_[l].store.border(x);
+        return out;
+    }
+
+    // One probe per corner and leaf row serves every layer of the row.
+    void sample_all(const Vec2& x, std::vector<FieldSample>& out) const {
+        out.resize(layers_.size());
+        int i0 = 0, j0 = 0;
+        double fx = 0.0, fy = 0.0;
+        if (!cell_of(x, i0, j0, fx, fy)) {
+            for (std::size_t l = 0; l < layers_.size(); ++l) {
+                out[l] = FieldSample{};
+                out[l].value = band_;
+                out[l].border = layers_[l].store.border(x);
+            }
+            return;
+        }
+        ConstAccessor acc(tree());
+        const Leaf* leaf[4] = {nullptr, nullptr, nullptr, nullptr};
+        for (std::size_t l = 0; l < layers_.size(); ++l) {
+            const int z = static_cast<int>(l);
+            if (z % kLeafDim == 0) probe_corners(acc, i0, j0, z, leaf);
+            float v[4];
+            const bool on = read_corners(acc, leaf, i0, j0, z, v);
+            out[l] = bilinear(v, fx, fy, h_);
+            out[l].in_band = on;
+            out[l].border = layers_[l].store.border(x);
+        }
+    }
+
+    void update(std::size_t l, const std::vector<Vec2>& points, const PolylineEdit& edit) {
+        LayerData& d = layers_[l];
         if (edit.first + edit.inserted <= points.size())
-            check_extent(points, edit.first, edit.first + edit.inserted);
+            check_extent(d.name, points, edit.first, edit.first + edit.inserted);
         std::vector<std::uint32_t> removed, added;
-        if (!store_.splice(points, edit, removed, added)) {
-            set_outside_sign(store_.outside_sign());
-            rebuild();
+        if (!d.store.splice(points, edit, removed, added)) {
+            // Not local: the store was rebuilt. Recompute the layer's plane in every leaf of its
+            // row and in every leaf its new segments reach.
+            d.index.build(d.store);
+            std::vector<std::uint64_t> keys;
+            const int row_z = row_origin_z(l);
+            for (auto it = tree().cbeginLeaf(); it; ++it)
+                if (it->origin().z() == row_z)
+                    keys.push_back(
+                        leaf_key(it->origin().x() / kLeafDim, it->origin().y() / kLeafDim));
+            const auto& segs = d.store.segments();
+            for (const Segment& s : segs)
+                if (s.live) for_leaves(s, [&](std::uint64_t k) { keys.push_back(k); });
+            refresh(l, std::move(keys));
             return;
         }
         if (removed.empty() && added.empty()) return;
         std::vector<std::uint64_t> keys;
+        Box2 chain;
         for (std::uint32_t s : removed) {
-            for_leaves(store_.segments()[s], [&](std::uint64_t k) {
-                keys.push_back(k);
-                const auto it = buckets_.find(k);
-                if (it == buckets_.end()) return;
-                auto& ids = it->second;
-                ids.erase(std::remove(ids.begin(), ids.end(), s), ids.end());
-                if (ids.empty()) buckets_.erase(it);
-            });
+            const Segment& seg = d.store.segments()[s];
+            for_leaves(seg, [&](std::uint64_t k) { keys.push_back(k); });
+            chain.extend(seg.box());
+            d.index.erase(d.store, s);
         }
         for (std::uint32_t s : added) {
-            for_leaves(store_.segments()[s], [&](std::uint64_t k) {
-                keys.push_back(k);
-                buckets_[k].push_back(s);
-            });
+            const Segment& seg = d.store.segments()[s];
+            for_leaves(seg, [&](std::uint64_t k) { keys.push_back(k); });
+            chain.extend(seg.box());
+            d.index.insert(d.store, s);
         }
-        std::sort(keys.begin(), keys.end());
-        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-        const std::vector<Leaf*> leaves = compute_leaves(keys);
-        Tree& tree = grid_->tree();
-        const float bg = static_cast<float>(band_);
-        for (std::size_t k = 0; k < keys.size(); ++k) {
-            const openvdb::Coord origin = leaf_origin(keys[k]);
-            if (leaves[k] != nullptr) {
-                tree.addLeaf(leaves[k]);
-            } else if (tree.probeConstLeaf(origin) != nullptr) {
-                tree.addTile(1, origin, bg, false);
-            }
-        }
-        // What finish_tree() does, restricted to the internal nodes above the swapped leaves:
-        // nodes left without children become background tiles (as pruneInactive does), then
-        // the touched nodes are flood filled bottom-up. The other nodes are unchanged, so the
-        // tree equals a full rebuild.
-        std::vector<openvdb::Coord> n1_origins, n2_origins;
-        for (std::uint64_t key : keys) {
-            const openvdb::Coord origin = leaf_origin(key);
-            if (N1* n1 = tree.probeNode<N1>(origin)) {
-                if (n1->getChildMask().isOff()) {
-                    tree.addTile(2, origin, bg, false);
-                } else {
-                    n1_origins.push_back(n1->origin());
-                }
-            }
-            if (N2* n2 = tree.probeNode<N2>(origin)) {
-                if (n2->getChildMask().isOff()) {
-                    tree.addTile(3, origin, bg, false);
-                } else {
-                    n2_origins.push_back(n2->origin());
-                }
-            }
-        }
-        const auto unique = [](std::vector<openvdb::Coord>& v) {
-            std::sort(v.begin(), v.end());
-            v.erase(std::unique(v.begin(), v.end()), v.end());
-        };
-        unique(n1_origins);
-        unique(n2_origins);
-        const openvdb::tools::SignedFloodFillOp<Tree> fill(tree, 1);
-        for (const openvdb::Coord& o : n1_origins)
-            if (N1* n1 = tree.probeNode<N1>(o)) fill(*n1);
-        for (const openvdb::Coord& o : n2_origins)
-            if (N2* n2 = tree.probeNode<N2>(o)) fill(*n2);
-        // The root is not filled again: its step only adds inside tiles between two children of
-        // the same z column, and every child of a z = 0 slab lies in the z = 0 row, so it adds
-        // nothing (the full rebuild's root step adds nothing either). It would cost a sorted
-        // copy of all root children, which grows with the layer (~13 % of an update at 1M).
+        // A closed layer's sign changes only inside the loop of the old and new chains (which
+        // share their end vertices), so within the chain's box: the planes of leaves there where
+        // the layer has no band voxel take the new sign.
+        if (d.closed) leaves_touching(chain, row_origin_z(l), keys);
+        refresh(l, std::move(keys));
     }
 
-    FieldStats stats() const override {
+    FieldStats stats(std::size_t l) const {
+        const LayerData& d = layers_[l];
         FieldStats st;
-        st.segments = store_.segment_count();
-        st.memory_bytes = static_cast<std::size_t>(grid_->memUsage()) + store_.memory_bytes();
-        for (const auto& [key, ids] : buckets_)
-            st.memory_bytes += sizeof(key) + sizeof(ids) + ids.capacity() * sizeof(std::uint32_t);
+        st.segments = d.store.segment_count();
+        const int z = static_cast<int>(l), row_z = row_origin_z(l);
+        openvdb::CoordBBox bb;
+        for (auto it = tree().cbeginLeaf(); it; ++it) {
+            if (it->origin().z() != row_z) continue;
+            const std::size_t on = plane_active_count(*it, z);
+            if (on == 0) continue;
+            st.active_voxels += on;
+            ++st.leaves;
+            for (int vx = 0; vx < kLeafDim; ++vx)
+                for (int vy = 0; vy < kLeafDim; ++vy)
+                    if (it->isValueOn(voxel_offset(vx, vy, z)))
+                        bb.expand(openvdb::Coord(it->origin().x() + vx, it->origin().y() + vy, 0));
+        }
+        if (!bb.empty()) {
+            st.bounds.extend(Vec2(bb.min().x(), bb.min().y()) * h_);
+            st.bounds.extend(Vec2(bb.max().x(), bb.max().y()) * h_);
+        }
+        // The shared grid is attributed in proportion to the layer's band voxels.
+        const auto total_active = static_cast<double>(grid_->activeVoxelCount());
+        const double share =
+            total_active > 0.0 ? static_cast<double>(st.active_voxels) / total_active : 0.0;
+        st.memory_bytes = d.store.memory_bytes() + d.index.memory_bytes() +
+                          static_cast<std::size_t>(share * static_cast<double>(grid_->memUsage()));
+        st.voxel_size = h_;
+        st.band_width = band_;
+        return st;
+    }
+
+    FieldStats total_stats() const {
+        FieldStats st;
+        st.memory_bytes = static_cast<std::size_t>(grid_->memUsage());
+        for (const LayerData& d : layers_) {
+            st.segments += d.store.segment_count();
+            st.memory_bytes += d.store.memory_bytes() + d.index.memory_bytes();
+        }
         st.active_voxels = static_cast<std::size_t>(grid_->activeVoxelCount());
-        st.leaves = static_cast<std::size_t>(grid_->tree().leafCount());
+        st.leaves = leaf_count_;
         const openvdb::CoordBBox bb = grid_->evalActiveVoxelBoundingBox();
         if (!bb.empty()) {
             st.bounds.extend(Vec2(bb.min().x(), bb.min().y()) * h_);
@@ -189,26 +296,171 @@ class GridField final : public LayerField {
         return st;
     }
 
-    const openvdb::FloatGrid& grid() const { return *grid_; }
-    double voxel_size() const { return h_; }
+    /// Layer l's value at voxels (i, j) for i in [i0, i1] (row j) into `values` / `active`
+    /// (appended): the stored plane value in a leaf, the walked +-band elsewhere.
+    void plane_row(std::size_t l, int i0, int i1, int j, std::vector<float>& values,
+                   std::vector<char>& active) const {
+        ConstAccessor acc(tree());
+        const int z = static_cast<int>(l);
+        const std::size_t first = values.size();
+        values.resize(first + static_cast<std::size_t>(i1 - i0 + 1));
+        active.resize(values.size());
+        // Right to left: a voxel in no leaf takes the sign of the next leaf voxel to its right.
+        float carry = walk(acc, i1, j, z);
+        for (int i = i1; i >= i0; --i) {
+            const openvdb::Coord xyz(i, j, z);
+            const auto k = first + static_cast<std::size_t>(i - i0);
+            if (const Leaf* leaf = acc.probeConstLeaf(xyz)) {
+                const openvdb::Index n = Leaf::coordToOffset(xyz);
+                values[k] = leaf->getValue(n);
+                active[k] = leaf->isValueOn(n) ? 1 : 0;
+                carry = values[k] < 0.f ? -static_cast<float>(band_) : static_cast<float>(band_);
+            } else {
+                values[k] = carry;
+                active[k] = 0;
+            }
+        }
+    }
+
+    /// Layer l as a standard z = 0 slab: the leaves where it has band voxels, its plane copied
+    /// to z = 0 and its signs to z = 1..7, internal nodes flood filled (as write_vdb writes it).
+    openvdb::FloatGrid::Ptr slab(std::size_t l) const {
+        const auto bg = static_cast<float>(band_);
+        auto grid = openvdb::FloatGrid::create(bg);
+        grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
+        grid->setGridClass(openvdb::GRID_LEVEL_SET);
+        grid->setName(layers_[l].name);
+        const int z = static_cast<int>(l), row_z = row_origin_z(l);
+        for (auto it = tree().cbeginLeaf(); it; ++it) {
+            if (it->origin().z() != row_z || plane_active_count(*it, z) == 0) continue;
+            auto* leaf = new Leaf(openvdb::Coord(it->origin().x(), it->origin().y(), 0), bg, false);
+            for (int vx = 0; vx < kLeafDim; ++vx)
+                for (int vy = 0; vy < kLeafDim; ++vy) {
+                    const openvdb::Index n = voxel_offset(vx, vy, z);
+                    const float v = it->getValue(n);
+                    const float off = v < 0.f ? -bg : bg;
+                    for (int vz = 0; vz < kLeafDim; ++vz) {
+                        if (vz == 0 && it->isValueOn(n)) {
+                            leaf->setValueOn(voxel_offset(vx, vy, 0), v);
+                        } else {
+                            leaf->setValueOff(voxel_offset(vx, vy, vz), vz == 0 ? v : off);
+                        }
+                    }
+                }
+            grid->tree().addLeaf(leaf);
+        }
+        openvdb::tools::signedFloodFill(grid->tree(), true, 1, 1);
+        return grid;
+    }
 
   private:
-    void check_extent(const std::vector<Vec2>& points, std::size_t begin, std::size_t end) const {
+    /// One layer's 64 voxels of a leaf: values (index vx * 8 + vy), band voxels (bit vx * 8 + vy).
+    struct Plane {
+        std::array<float, kPlane> value{};
+        std::uint64_t active = 0;
+    };
+
+    struct LayerData {
+        explicit LayerData(double cell) : index(cell) {}
+        std::string name;
+        bool closed = false;
+        SegmentStore store;
+        SegmentIndex index;
+    };
+
+    // What refresh() computes for one leaf (in parallel), applied serially.
+    struct Change {
+        Plane plane;
+        bool band = false;           // the layer has band voxels in the leaf
+        bool exists = false;         // the leaf exists now
+        bool keep = false;           // no band voxels, but another plane has some
+        float off = 0.f;             // the layer's plane value when it has no band voxels
+        std::vector<float> row_off;  // new leaf: every plane of the row without band voxels
+    };
+
+    static int row_origin_z(std::size_t l) { return static_cast<int>(l) / kLeafDim * kLeafDim; }
+
+    std::size_t row_end(std::size_t l) const {
+        return std::min(layers_.size(), static_cast<std::size_t>(row_origin_z(l) + kLeafDim));
+    }
+
+    void check_extent(const std::string& layer, const std::vector<Vec2>& points, std::size_t begin,
+                      std::size_t end) const {
         for (std::size_t i = begin; i < end; ++i)
             if (const Vec2& p = points[i]; !(std::abs(p.x / h_) + band_ / h_ < 0.5 * kMaxIndex &&
                                              std::abs(p.y / h_) + band_ / h_ < 0.5 * kMaxIndex))
-                throw InvalidInput("make_field: layer '" + name() +
+                throw InvalidInput("make_field: layer '" + layer +
                                    "' spans more than 2^29 "
                                    "voxels of size " +
                                    format_number(h_) + " (raise FieldParams::voxel_size)");
     }
 
-    static openvdb::Coord leaf_origin(std::uint64_t key) {
-        return openvdb::Coord(static_cast<int>(key_i(key) * kLeafDim),
-                              static_cast<int>(key_j(key) * kLeafDim), 0);
+    // The cell of x: lower corner (i0, j0) and position (fx, fy) in it; false beyond 2^30 voxels.
+    bool cell_of(const Vec2& x, int& i0, int& j0, double& fx, double& fy) const {
+        const double gx = x.x / h_, gy = x.y / h_;
+        if (!(std::abs(gx) < kMaxIndex && std::abs(gy) < kMaxIndex)) return false;
+        const double fx0 = std::floor(gx), fy0 = std::floor(gy);
+        i0 = static_cast<int>(fx0);
+        j0 = static_cast<int>(fy0);
+        fx = gx - fx0;
+        fy = gy - fy0;
+        return true;
     }
 
-    // Leaves holding a voxel centre (i h, j h) within the band of the segment's bounding box.
+    static void probe_corners(ConstAccessor& acc, int i0, int j0, int z, const Leaf* (&leaf)[4]) {
+        for (int c = 0; c < 4; ++c)
+            leaf[c] = acc.probeConstLeaf(openvdb::Coord(i0 + (c & 1), j0 + (c >> 1), z));
+    }
+
+    // Layer z's corner values (00, 10, 01, 11) from the corner leaves (nullptr: no leaf);
+    // true when all four are band voxels.
+    bool read_corners(ConstAccessor& acc, const Leaf* const (&leaf)[4], int i0, int j0, int z,
+                      float (&v)[4]) const {
+        bool on = true;
+        for (int row = 0; row < 2; ++row) {
+            const int c0 = 2 * row, c1 = 2 * row + 1, j = j0 + row;
+            // Right corner first: a left corner in no leaf takes the sign of the right one.
+            if (leaf[c1] != nullptr) {
+                const openvdb::Index n = Leaf::coordToOffset(openvdb::Coord(i0 + 1, j, z));
+                v[c1] = leaf[c1]->getValue(n);
+                on = on && leaf[c1]->isValueOn(n);
+            } else {
+                v[c1] = walk(acc, i0 + 1, j, z);
+                on = false;
+            }
+            if (leaf[c0] != nullptr) {
+                const openvdb::Index n = Leaf::coordToOffset(openvdb::Coord(i0, j, z));
+                v[c0] = leaf[c0]->getValue(n);
+                on = on && leaf[c0]->isValueOn(n);
+            } else {
+                v[c0] = v[c1] < 0.f ? -static_cast<float>(band_) : static_cast<float>(band_);
+                on = false;
+            }
+        }
+        return on;
+    }
+
+    // Value of layer z at voxel (i, j), which is in no leaf: +-band with the sign of the first
+    // leaf voxel of plane z to its right (row j), +band when there is none. Between the two
+    // every voxel is in no leaf, so no layer of the row is in band there: a closed layer's
+    // curve does not cross the row there (a crossing is within h/2 of a voxel centre), its
+    // sign is the same. Tiles are skipped whole; the walk ends past the rightmost leaf.
+    float walk(ConstAccessor& acc, int i, int j, int z) const {
+        const auto bg = static_cast<float>(band_);
+        long x = static_cast<long>(i) + 1;
+        while (x <= max_leaf_x_) {
+            const openvdb::Coord xyz(static_cast<int>(x), j, z);
+            if (const Leaf* leaf = acc.probeConstLeaf(xyz))
+                return leaf->getValue(Leaf::coordToOffset(xyz)) < 0.f ? -bg : bg;
+            const int depth = acc.getValueDepth(xyz);  // 2: leaf-sized tile, 1: 128, else 4096
+            const long span = depth == 2 ? 8 : (depth == 1 ? 128 : 4096);
+            x = (floor_div(x, span) + 1) * span;
+        }
+        return bg;
+    }
+
+    // Leaves of the layer's row holding a voxel centre (i h, j h) within the band of the
+    // segment's bounding box.
     template <typename F>
     void for_leaves(const Segment& s, F&& f) const {
         const Box2 box = s.box().inflated(band_);
@@ -217,40 +469,69 @@ class GridField final : public LayerField {
         const long j0 = static_cast<long>(std::ceil(box.min.y / h_));
         const long j1 = static_cast<long>(std::floor(box.max.y / h_));
         if (i0 > i1 || j0 > j1) return;
-        for (long li = floor_div8(i0); li <= floor_div8(i1); ++li)
-            for (long lj = floor_div8(j0); lj <= floor_div8(j1); ++lj) f(leaf_key(li, lj));
+        for (long li = floor_div(i0, kLeafDim); li <= floor_div(i1, kLeafDim); ++li)
+            for (long lj = floor_div(j0, kLeafDim); lj <= floor_div(j1, kLeafDim); ++lj)
+                f(leaf_key(li, lj));
     }
 
-    // One leaf: exact values on its 8 x 8 voxels of z = 0, signs of inactive voxels spread
-    // from their 4-neighbours (a sign change between neighbours puts both within h <= band of
-    // the curve, so both are active), the 7 slabs above copy the z = 0 signs so that the
-    // flood fill of the internal nodes (which reads each leaf's first and last values) sees
-    // the z = 0 signs. nullptr when no voxel is in the band.
-    Leaf* compute_leaf(std::uint64_t key) const {
-        const auto it = buckets_.find(key);
-        if (it == buckets_.end()) return nullptr;
-        const std::vector<std::uint32_t>& ids = it->second;
+    // Appends the keys of the existing leaves of row `row_z` that touch `box`.
+    void leaves_touching(const Box2& box, int row_z, std::vector<std::uint64_t>& keys) const {
+        const long li0 = floor_div(static_cast<long>(std::floor(box.min.x / h_)), kLeafDim);
+        const long li1 = floor_div(static_cast<long>(std::ceil(box.max.x / h_)), kLeafDim);
+        const long lj0 = floor_div(static_cast<long>(std::floor(box.min.y / h_)), kLeafDim);
+        const long lj1 = floor_div(static_cast<long>(std::ceil(box.max.y / h_)), kLeafDim);
+        const auto positions =
+            static_cast<double>(li1 - li0 + 1) * static_cast<double>(lj1 - lj0 + 1);
+        if (positions <= 4.0 * static_cast<double>(leaf_count_)) {
+            for (long li = li0; li <= li1; ++li)
+                for (long lj = lj0; lj <= lj1; ++lj)
+                    if (tree().probeConstLeaf(leaf_origin(leaf_key(li, lj), row_z)) != nullptr)
+                        keys.push_back(leaf_key(li, lj));
+            return;
+        }
+        for (auto it = tree().cbeginLeaf(); it; ++it) {
+            const long li = it->origin().x() / kLeafDim, lj = it->origin().y() / kLeafDim;
+            if (it->origin().z() == row_z && li >= li0 && li <= li1 && lj >= lj0 && lj <= lj1)
+                keys.push_back(leaf_key(li, lj));
+        }
+    }
+
+    static openvdb::Coord leaf_origin(std::uint64_t key, int row_z) {
+        return openvdb::Coord(static_cast<int>(key_i(key) * kLeafDim),
+                              static_cast<int>(key_j(key) * kLeafDim), row_z);
+    }
+
+    // Layer d's band voxels in leaf `key`: exact values, and the other voxels' signs spread from
+    // their 4-neighbours inside the leaf (a sign change between neighbours puts both within
+    // h <= band of the curve, so both are band voxels). False when it has none.
+    bool band_plane(const LayerData& d, std::uint64_t key, Plane& plane,
+                    std::vector<std::uint32_t>& ids) const {
         const long oi = key_i(key) * kLeafDim, oj = key_j(key) * kLeafDim;
-        std::array<float, 64> value{};
-        std::array<int, 64> sign{};
-        std::array<bool, 64> active{};
+        Box2 box;
+        box.extend(Vec2(static_cast<double>(oi) * h_, static_cast<double>(oj) * h_));
+        box.extend(Vec2(static_cast<double>(oi + kLeafDim - 1) * h_,
+                        static_cast<double>(oj + kLeafDim - 1) * h_));
+        // Every segment within band of a voxel centre has a point in the box inflated by the
+        // band (one more voxel against rounding), so it is listed in a bucket the box touches.
+        d.index.candidates(box.inflated(band_ + h_), ids);
+        if (ids.empty()) return false;
+        std::array<int, kPlane> sign{};
         const double band2 = band_ * band_;
-        bool any = false;
+        plane.active = 0;
         for (int vx = 0; vx < kLeafDim; ++vx)
             for (int vy = 0; vy < kLeafDim; ++vy) {
                 const int k = vx * kLeafDim + vy;
                 const Vec2 p(static_cast<double>(oi + vx) * h_, static_cast<double>(oj + vy) * h_);
                 Nearest best;
-                for (std::uint32_t s : ids) store_.offer(p, s, best);
+                for (std::uint32_t s : ids) d.store.offer(p, s, best);
                 if (best.found() && best.dist2 <= band2) {
-                    const double v = store_.evaluate(p, best).value;
-                    value[static_cast<std::size_t>(k)] = static_cast<float>(v);
+                    const double v = d.store.evaluate(p, best).value;
+                    plane.value[static_cast<std::size_t>(k)] = static_cast<float>(v);
                     sign[static_cast<std::size_t>(k)] = v < 0.0 ? -1 : 1;
-                    active[static_cast<std::size_t>(k)] = true;
-                    any = true;
+                    plane.active |= std::uint64_t{1} << k;
                 }
             }
-        if (!any) return nullptr;
+        if (plane.active == 0) return false;
         for (bool changed = true; changed;) {
             changed = false;
             for (int vx = 0; vx < kLeafDim; ++vx)
@@ -269,68 +550,210 @@ class GridField final : public LayerField {
                     }
                 }
         }
-        const float bg = static_cast<float>(band_);
-        auto* leaf =
-            new Leaf(openvdb::Coord(static_cast<int>(oi), static_cast<int>(oj), 0), bg, false);
+        const auto bg = static_cast<float>(band_);
+        for (std::size_t k = 0; k < static_cast<std::size_t>(kPlane); ++k)
+            if ((plane.active >> k & 1u) == 0) plane.value[k] = sign[k] < 0 ? -bg : bg;
+        return true;
+    }
+
+    // Layer d's value in a leaf where it has no band voxel: +-band with its exact sign at the
+    // leaf's origin voxel for a closed layer (the sign is the same over the leaf: the curve
+    // keeps more than band - h / sqrt 2 > 0 away from every point between its voxel centres);
+    // +band for an open layer, whose sign out of the band is not meaningful (and could change
+    // far from an edit of an end segment).
+    float off_plane_value(const LayerData& d, std::uint64_t key) const {
+        const auto bg = static_cast<float>(band_);
+        if (!d.closed) return bg;
+        const Vec2 p(static_cast<double>(key_i(key) * kLeafDim) * h_,
+                     static_cast<double>(key_j(key) * kLeafDim) * h_);
+        Nearest best;
+        d.index.search(d.store, p, best);
+        return d.store.evaluate(p, best).value < 0.0 ? -bg : bg;
+    }
+
+    static void write_plane(Leaf& leaf, int z, const Plane& plane) {
         for (int vx = 0; vx < kLeafDim; ++vx)
             for (int vy = 0; vy < kLeafDim; ++vy) {
-                const auto k = static_cast<std::size_t>(vx * kLeafDim + vy);
-                const float off_value = sign[k] < 0 ? -bg : bg;
-                for (int vz = 0; vz < kLeafDim; ++vz) {
-                    const openvdb::Index n = Leaf::coordToOffset(openvdb::Coord(vx, vy, vz));
-                    if (vz == 0 && active[k]) {
-                        leaf->setValueOn(n, value[k]);
-                    } else {
-                        leaf->setValueOff(n, off_value);
-                    }
+                const int k = vx * kLeafDim + vy;
+                const openvdb::Index n = voxel_offset(vx, vy, z);
+                if ((plane.active >> k & 1u) != 0) {
+                    leaf.setValueOn(n, plane.value[static_cast<std::size_t>(k)]);
+                } else {
+                    leaf.setValueOff(n, plane.value[static_cast<std::size_t>(k)]);
                 }
             }
-        return leaf;
     }
 
-    std::vector<Leaf*> compute_leaves(const std::vector<std::uint64_t>& keys) const {
-        std::vector<Leaf*> leaves(keys.size(), nullptr);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t k = r.begin(); k != r.end(); ++k)
-                                  leaves[k] = compute_leaf(keys[k]);
-                          });
-        return leaves;
+    static void write_uniform(Leaf& leaf, int z, float value) {
+        for (int vx = 0; vx < kLeafDim; ++vx)
+            for (int vy = 0; vy < kLeafDim; ++vy) leaf.setValueOff(voxel_offset(vx, vy, z), value);
     }
 
-    // Removes internal nodes left without active voxels, then gives every tile of the
-    // internal nodes the sign of its neighbours (leaves are already signed: minLevel 1).
-    void finish_tree(Tree& tree) const {
-        openvdb::tools::pruneInactive(tree, true, 1);
-        openvdb::tools::signedFloodFill(tree, true, 1, 1);
+    void add_leaf(Tree& tree, Leaf* leaf) {
+        tree.addLeaf(leaf);
+        ++leaf_count_;
+        max_leaf_x_ = std::max(max_leaf_x_, static_cast<long>(leaf->origin().x()) + kLeafDim - 1);
     }
 
-    void rebuild() {
-        buckets_.clear();
-        const auto& segs = store_.segments();
-        for (std::uint32_t s = 0; s < segs.size(); ++s)
-            if (segs[s].live)
-                for_leaves(segs[s], [&](std::uint64_t k) { buckets_[k].push_back(s); });
-        std::vector<std::uint64_t> keys;
-        keys.reserve(buckets_.size());
-        for (const auto& entry : buckets_) keys.push_back(entry.first);
-        std::sort(keys.begin(), keys.end());
-        const std::vector<Leaf*> leaves = compute_leaves(keys);
+    // Full build: per row, the leaves any of its layers reaches, computed in parallel (one task
+    // per leaf), inserted serially.
+    void build() {
         auto grid = openvdb::FloatGrid::create(static_cast<float>(band_));
         grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
         grid->setGridClass(openvdb::GRID_LEVEL_SET);
-        grid->setName(name());
-        for (Leaf* leaf : leaves)
-            if (leaf != nullptr) grid->tree().addLeaf(leaf);
-        finish_tree(grid->tree());
+        grid->setName("strata_layers");
         grid_ = grid;
+        leaf_count_ = 0;
+        max_leaf_x_ = std::numeric_limits<long>::min();
+        for (std::size_t first = 0; first < layers_.size(); first += kLeafDim) {
+            const std::size_t last = row_end(first);
+            std::vector<std::pair<std::uint64_t, std::uint32_t>> reach;  // (leaf key, layer)
+            for (std::size_t l = first; l < last; ++l) {
+                std::vector<std::uint64_t> keys;
+                for (const Segment& s : layers_[l].store.segments())
+                    if (s.live) for_leaves(s, [&](std::uint64_t k) { keys.push_back(k); });
+                std::sort(keys.begin(), keys.end());
+                keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+                for (std::uint64_t k : keys) reach.emplace_back(k, static_cast<std::uint32_t>(l));
+            }
+            std::sort(reach.begin(), reach.end());
+            std::vector<std::size_t> starts;  // groups of one leaf key
+            for (std::size_t k = 0; k < reach.size(); ++k)
+                if (k == 0 || reach[k].first != reach[k - 1].first) starts.push_back(k);
+            starts.push_back(reach.size());
+            const int row_z = row_origin_z(first);
+            std::vector<Leaf*> leaves(starts.size() - 1, nullptr);
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 16),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                  std::vector<std::uint32_t> ids;
+                                  Plane plane;
+                                  for (std::size_t g = r.begin(); g != r.end(); ++g) {
+                                      const std::uint64_t key = reach[starts[g]].first;
+                                      Leaf* leaf = nullptr;
+                                      std::uint32_t has = 0;  // planes of the row with band voxels
+                                      for (std::size_t k = starts[g]; k < starts[g + 1]; ++k) {
+                                          const std::uint32_t l = reach[k].second;
+                                          if (!band_plane(layers_[l], key, plane, ids)) continue;
+                                          if (leaf == nullptr)
+                                              leaf = new Leaf(leaf_origin(key, row_z),
+                                                              static_cast<float>(band_), false);
+                                          write_plane(*leaf, static_cast<int>(l), plane);
+                                          has |= 1u << (l - first);
+                                      }
+                                      if (leaf == nullptr) continue;
+                                      for (std::size_t l = first; l < last; ++l)
+                                          if ((has >> (l - first) & 1u) == 0)
+                                              write_uniform(*leaf, static_cast<int>(l),
+                                                            off_plane_value(layers_[l], key));
+                                      leaves[g] = leaf;
+                                  }
+                              });
+            for (Leaf* leaf : leaves)
+                if (leaf != nullptr) add_leaf(grid_->tree(), leaf);
+        }
+    }
+
+    // Recomputes layer l's plane in the leaves `keys` (its row), creating the leaves it now
+    // reaches and removing those no plane needs any more; then internal nodes left without
+    // children become tiles, as in a fresh build.
+    void refresh(std::size_t l, std::vector<std::uint64_t> keys) {
+        std::sort(keys.begin(), keys.end());
+        keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+        const LayerData& d = layers_[l];
+        const int z = static_cast<int>(l), row_z = row_origin_z(l);
+        const std::size_t first = static_cast<std::size_t>(row_z), last = row_end(l);
+        std::vector<Change> changes(keys.size());
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, keys.size(), 4),
+            [&](const tbb::blocked_range<std::size_t>& r) {
+                std::vector<std::uint32_t> ids;
+                for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                    Change& c = changes[k];
+                    const Leaf* leaf = tree().probeConstLeaf(leaf_origin(keys[k], row_z));
+                    c.exists = leaf != nullptr;
+                    c.band = band_plane(d, keys[k], c.plane, ids);
+                    if (c.band && !c.exists) {
+                        for (std::size_t o = first; o < last; ++o)
+                            c.row_off.push_back(o == l ? static_cast<float>(band_)
+                                                       : off_plane_value(layers_[o], keys[k]));
+                    } else if (!c.band && c.exists) {
+                        c.keep = other_planes_active(*leaf, z);
+                        if (c.keep) c.off = off_plane_value(d, keys[k]);
+                    }
+                }
+            });
+        Tree& tree = grid_->tree();
+        const auto bg = static_cast<float>(band_);
+        std::vector<openvdb::Coord> removed;
+        for (std::size_t k = 0; k < keys.size(); ++k) {
+            const Change& c = changes[k];
+            const openvdb::Coord origin = leaf_origin(keys[k], row_z);
+            if (c.band) {
+                Leaf* leaf = tree.probeLeaf(origin);
+                if (leaf == nullptr) {
+                    leaf = new Leaf(origin, bg, false);
+                    for (std::size_t o = first; o < last; ++o)
+                        write_uniform(*leaf, static_cast<int>(o), c.row_off[o - first]);
+                    add_leaf(tree, leaf);
+                }
+                write_plane(*leaf, z, c.plane);
+            } else if (c.exists && c.keep) {
+                write_uniform(*tree.probeLeaf(origin), z, c.off);
+            } else if (c.exists) {
+                tree.addTile(1, origin, bg, false);
+                --leaf_count_;
+                removed.push_back(origin);
+            }
+        }
+        bool root_tiles = false;
+        for (const openvdb::Coord& origin : removed) {
+            if (const N1* n1 = tree.probeConstNode<N1>(origin);
+                n1 != nullptr && n1->getChildMask().isOff())
+                tree.addTile(2, origin, bg, false);
+            if (const N2* n2 = tree.probeConstNode<N2>(origin);
+                n2 != nullptr && n2->getChildMask().isOff()) {
+                tree.addTile(3, origin, bg, false);
+                root_tiles = true;
+            }
+        }
+        // A fresh build has no root tiles; rare (a 4096-voxel node emptied), O(root children).
+        if (root_tiles) tree.root().eraseBackgroundTiles();
     }
 
     double h_ = 1.0;
     double band_ = 1.0;
-    SegmentStore store_;
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> buckets_;
+    std::vector<LayerData> layers_;
     openvdb::FloatGrid::Ptr grid_;
+    std::size_t leaf_count_ = 0;
+    long max_leaf_x_ = std::numeric_limits<long>::min();  // >= every leaf's last voxel x
+};
+
+namespace {
+
+/// Layer `layer_` of a GridStack (shared with the other layers of its SceneFields).
+class GridField final : public LayerField {
+  public:
+    GridField(std::shared_ptr<GridStack> stack, std::size_t layer)
+        : LayerField(stack->name(layer), stack->is_closed(layer), stack->outside_sign(layer)),
+          stack_(std::move(stack)),
+          layer_(layer) {}
+
+    FieldSample sample(const Vec2& x) const override { return stack_->sample(layer_, x); }
+    FieldSample sample_in_band(const Vec2& x) const override {
+        return stack_->sample_in_band(layer_, x);
+    }
+    void update(const std::vector<Vec2>& points, const PolylineEdit& edit) override {
+        stack_->update(layer_, points, edit);
+        set_outside_sign(stack_->outside_sign(layer_));
+    }
+    FieldStats stats() const override { return stack_->stats(layer_); }
+
+    const GridStack& stack() const { return *stack_; }
+    std::size_t layer() const { return layer_; }
+
+  private:
+    std::shared_ptr<GridStack> stack_;
+    std::size_t layer_ = 0;
 };
 
 std::string coord_text(const openvdb::Coord& c) {
@@ -346,11 +769,43 @@ const GridField& as_grid(const LayerField& field, const char* where) {
     return *g;
 }
 
+bool same_bits(float a, float b) {
+    return std::memcmp(&a, &b, sizeof(float)) == 0;
+}
+
+// Internal node a against b: masks and tile values bit for bit; children compared by the caller.
+template <typename Node>
+bool same_node(const Node& a, const Node& b) {
+    if (a.getChildMask() != b.getChildMask() || a.getValueMask() != b.getValueMask()) return false;
+    for (auto it = a.cbeginValueAll(); it; ++it)
+        if (!same_bits(*it, b.getValue(it.getCoord()))) return false;
+    return true;
+}
+
 }  // namespace
+
+GridFields make_grid_fields(const std::vector<const Layer*>& layers,
+                            const std::vector<int>& outside_signs,
+                            const ResolvedFieldParams& params) {
+    auto stack = std::make_shared<GridStack>(layers, outside_signs, params);
+    GridFields out;
+    out.stack = stack;
+    for (std::size_t l = 0; l < layers.size(); ++l)
+        out.fields.push_back(std::make_unique<GridField>(stack, l));
+    return out;
+}
 
 std::unique_ptr<LayerField> make_grid_field(const Layer& layer, int outside_sign,
                                             const ResolvedFieldParams& params) {
-    return std::make_unique<GridField>(layer, outside_sign, params);
+    return std::move(make_grid_fields({&layer}, {outside_sign}, params).fields.front());
+}
+
+void grid_sample_all(const GridStack& stack, const Vec2& x, std::vector<FieldSample>& out) {
+    stack.sample_all(x, out);
+}
+
+FieldStats grid_total_stats(const GridStack& stack) {
+    return stack.total_stats();
 }
 
 bool grids_identical(const LayerField& fa, const LayerField& fb, std::string* why) {
@@ -358,12 +813,29 @@ bool grids_identical(const LayerField& fa, const LayerField& fb, std::string* wh
         if (why != nullptr) *why = msg;
         return false;
     };
-    const Tree& a = as_grid(fa, "grids_identical").grid().tree();
-    const Tree& b = as_grid(fb, "grids_identical").grid().tree();
+    const GridField& ga = as_grid(fa, "grids_identical");
+    const GridField& gb = as_grid(fb, "grids_identical");
+    if (ga.layer() != gb.layer() || ga.stack().size() != gb.stack().size())
+        return fail("layer " + std::to_string(ga.layer()) + " of " +
+                    std::to_string(ga.stack().size()) + " vs layer " + std::to_string(gb.layer()) +
+                    " of " + std::to_string(gb.stack().size()));
+    const Tree& a = ga.stack().tree();
+    const Tree& b = gb.stack().tree();
+    if (!same_bits(a.background(), b.background())) return fail("backgrounds differ");
+    if (a.root().getTableSize() != b.root().getTableSize())
+        return fail("root tables of " + std::to_string(a.root().getTableSize()) + " vs " +
+                    std::to_string(b.root().getTableSize()) + " entries");
+    for (auto it = a.root().cbeginChildOn(); it; ++it) {
+        const N2* other = b.root().probeConstNode<N2>(it->origin());
+        if (other == nullptr || other->origin() != it->origin() || !same_node(*it, *other))
+            return fail("internal node " + coord_text(it->origin()) + " differs");
+        for (auto n1 = it->cbeginChildOn(); n1; ++n1)
+            if (!same_node(*n1, *other->probeConstNode<N1>(n1->origin())))
+                return fail("internal node " + coord_text(n1->origin()) + " differs");
+    }
     if (a.leafCount() != b.leafCount())
         return fail("leaf counts " + std::to_string(a.leafCount()) + " vs " +
                     std::to_string(b.leafCount()));
-    if (a.background() != b.background()) return fail("backgrounds differ");
     for (auto it = a.cbeginLeaf(); it; ++it) {
         const Leaf* other = b.probeConstLeaf(it->origin());
         if (other == nullptr) return fail("leaf " + coord_text(it->origin()) + " missing");
@@ -373,30 +845,39 @@ bool grids_identical(const LayerField& fa, const LayerField& fb, std::string* wh
             0)
             return fail("values of leaf " + coord_text(it->origin()) + " differ");
     }
+    // The layer's plane as sample() reads it, leaves and walked voxels.
     openvdb::CoordBBox bb, bb_b;
     a.evalLeafBoundingBox(bb);
     b.evalLeafBoundingBox(bb_b);
     bb.expand(bb_b);
     if (bb.empty()) return true;
     bb.expand(256);
-    ConstAccessor aa(a), ab(b);
-    for (int i = bb.min().x(); i <= bb.max().x(); ++i)
-        for (int j = bb.min().y(); j <= bb.max().y(); ++j) {
-            const openvdb::Coord c(i, j, 0);
-            const float va = aa.getValue(c), vb = ab.getValue(c);
-            if (std::memcmp(&va, &vb, sizeof(float)) != 0 || aa.isValueOn(c) != ab.isValueOn(c))
-                return fail("voxel " + coord_text(c) + ": " + std::to_string(va) + " vs " +
-                            std::to_string(vb));
-        }
+    std::vector<float> va, vb;
+    std::vector<char> ona, onb;
+    for (int j = bb.min().y(); j <= bb.max().y(); ++j) {
+        va.clear();
+        vb.clear();
+        ona.clear();
+        onb.clear();
+        ga.stack().plane_row(ga.layer(), bb.min().x(), bb.max().x(), j, va, ona);
+        gb.stack().plane_row(gb.layer(), bb.min().x(), bb.max().x(), j, vb, onb);
+        for (std::size_t k = 0; k < va.size(); ++k)
+            if (!same_bits(va[k], vb[k]) || ona[k] != onb[k])
+                return fail("voxel (" + std::to_string(bb.min().x() + static_cast<int>(k)) + ", " +
+                            std::to_string(j) + ") of layer " + std::to_string(ga.layer()) + ": " +
+                            std::to_string(va[k]) + " vs " + std::to_string(vb[k]));
+    }
     return true;
 }
 
 double max_box_sampler_difference(const LayerField& field, const std::vector<Vec2>& points) {
     const GridField& g = as_grid(field, "max_box_sampler_difference");
-    ConstAccessor acc(g.grid().tree());
+    const openvdb::FloatGrid::Ptr slab = g.stack().slab(g.layer());
+    ConstAccessor acc(slab->tree());
+    const double h = g.stack().voxel_size();
     double worst = 0.0;
     for (const Vec2& p : points) {
-        const openvdb::Vec3R ijk(p.x / g.voxel_size(), p.y / g.voxel_size(), 0.0);
+        const openvdb::Vec3R ijk(p.x / h, p.y / h, 0.0);
         const double box = static_cast<double>(openvdb::tools::BoxSampler::sample(acc, ijk));
         worst = std::max(worst, std::abs(box - field.sample(p).value));
     }
@@ -406,16 +887,25 @@ double max_box_sampler_difference(const LayerField& field, const std::vector<Vec
 void voxel_signs(const LayerField& field, int i0, int i1, int j0, int j1, std::vector<int>& signs,
                  std::vector<char>& active) {
     const GridField& g = as_grid(field, "voxel_signs");
-    ConstAccessor acc(g.grid().tree());
-    signs.clear();
+    std::vector<float> values;
     active.clear();
-    for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) {
-            float v = 0.f;
-            const bool on = acc.probeValue(openvdb::Coord(i, j, 0), v);
-            signs.push_back(v < 0.f ? -1 : (v > 0.f ? 1 : 0));
-            active.push_back(on ? 1 : 0);
-        }
+    for (int j = j0; j <= j1; ++j) g.stack().plane_row(g.layer(), i0, i1, j, values, active);
+    signs.clear();
+    for (const float v : values) signs.push_back(v < 0.f ? -1 : (v > 0.f ? 1 : 0));
+}
+
+std::size_t shared_leaf_count(const LayerField& a, const LayerField& b) {
+    const GridField& ga = as_grid(a, "shared_leaf_count");
+    const GridField& gb = as_grid(b, "shared_leaf_count");
+    if (&ga.stack() != &gb.stack()) return 0;
+    const int za = static_cast<int>(ga.layer()), zb = static_cast<int>(gb.layer());
+    std::size_t count = 0;
+    for (auto it = ga.stack().tree().cbeginLeaf(); it; ++it)
+        if (it->origin().z() == za / kLeafDim * kLeafDim &&
+            it->origin().z() == zb / kLeafDim * kLeafDim && plane_active_count(*it, za) > 0 &&
+            plane_active_count(*it, zb) > 0)
+            ++count;
+    return count;
 }
 
 }  // namespace strata::detail
@@ -432,17 +922,17 @@ void write_vdb(const Scene& scene, const SceneFields& fields, const std::filesys
     for (std::size_t i = 0; i < fields.size(); ++i) {
         const auto& g = detail::as_grid(fields.field(i), "write_vdb");
         const Layer& layer = scene.layer(i);
-        openvdb::FloatGrid::Ptr copy = g.grid().deepCopy();
-        copy->setName(layer.name);
-        copy->insertMeta("strata_voxel_size", openvdb::DoubleMetadata(fields.params().voxel_size));
-        copy->insertMeta("strata_band_width", openvdb::DoubleMetadata(fields.params().band_width));
-        copy->insertMeta("strata_units", openvdb::StringMetadata(scene.units()));
-        copy->insertMeta("strata_closed", openvdb::BoolMetadata(layer.closed));
-        copy->insertMeta("strata_outside_sign",
+        openvdb::FloatGrid::Ptr slab = g.stack().slab(g.layer());
+        slab->setName(layer.name);
+        slab->insertMeta("strata_voxel_size", openvdb::DoubleMetadata(fields.params().voxel_size));
+        slab->insertMeta("strata_band_width", openvdb::DoubleMetadata(fields.params().band_width));
+        slab->insertMeta("strata_units", openvdb::StringMetadata(scene.units()));
+        slab->insertMeta("strata_closed", openvdb::BoolMetadata(layer.closed));
+        slab->insertMeta("strata_outside_sign",
                          openvdb::Int32Metadata(fields.field(i).outside_sign()));
-        copy->insertMeta("strata_thickness", openvdb::DoubleMetadata(layer.thickness));
-        copy->insertMeta("strata_weight", openvdb::DoubleMetadata(layer.weight));
-        grids.push_back(copy);
+        slab->insertMeta("strata_thickness", openvdb::DoubleMetadata(layer.thickness));
+        slab->insertMeta("strata_weight", openvdb::DoubleMetadata(layer.weight));
+        grids.push_back(slab);
     }
     std::filesystem::path tmp = path;
     tmp += ".tmp";

@@ -192,6 +192,76 @@ void require_agreement(const Agreement& a) {
 
 }  // namespace
 
+namespace {
+
+/// `count` copies of one random star scaled by 1, 1 + gap, 1 + 2 gap, ...: nested closed layers
+/// closer than the band, so that they share leaves of the stacked grid.
+Scene nested_stars(std::mt19937& rng, std::size_t count, std::size_t n, double gap) {
+    const Layer star = random_star(rng, n, false);
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < count; ++k) {
+        Layer l = star;
+        l.name = "star" + std::to_string(k);
+        for (Vec2& p : l.points) p *= 1.0 + gap * static_cast<double>(k);
+        layers.push_back(std::move(l));
+    }
+    return Scene(layers);
+}
+
+bool same_sample(const FieldSample& a, const FieldSample& b) {
+    return a.value == b.value && a.gradient == b.gradient && a.in_band == b.in_band &&
+           (a.border == b.border || (std::isnan(a.border) && std::isnan(b.border)));
+}
+
+/// Query points: near every layer's vertices (in and just out of the band) and anywhere in the
+/// scene's box inflated by 4 bands (tiles included).
+std::vector<Vec2> scene_queries(const Scene& scene, double band, std::size_t count,
+                                std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    Box2 box;
+    for (const Layer& l : scene.layers()) box.extend(l.bounds());
+    box = box.inflated(4.0 * band);
+    std::uniform_real_distribution<double> ux(box.min.x, box.max.x), uy(box.min.y, box.max.y);
+    std::normal_distribution<double> near(0.0, band);
+    std::vector<Vec2> out;
+    for (std::size_t q = 0; q < count; ++q) {
+        if (q % 2 == 0) {
+            out.emplace_back(ux(rng), uy(rng));
+        } else {
+            const Layer& l = scene.layer(q / 2 % scene.size());
+            const Vec2& p = l.points[(q * 7919) % l.points.size()];
+            out.push_back(p + Vec2(near(rng), near(rng)));
+        }
+    }
+    return out;
+}
+
+/// Voxels of `field`'s plane (every `stride`-th of the box around the scene) whose sign is not
+/// the exact one (closed layer; voxels on the curve skipped).
+std::size_t voxel_sign_errors(const LayerField& field, const LayerField& exact, const Box2& box,
+                              double h, std::size_t& checked) {
+    const int i0 = static_cast<int>(std::floor(box.min.x / h));
+    const int i1 = static_cast<int>(std::ceil(box.max.x / h));
+    const int j0 = static_cast<int>(std::floor(box.min.y / h));
+    const int j1 = static_cast<int>(std::ceil(box.max.y / h));
+    std::vector<int> signs;
+    std::vector<char> active;
+    detail::voxel_signs(field, i0, i1, j0, j1, signs, active);
+    const int stride = std::max(1, (i1 - i0) / 200);
+    std::size_t errors = 0, k = 0;
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i, ++k) {
+            if ((i - i0) % stride != 0 || (j - j0) % stride != 0) continue;
+            const double v = exact.sample(Vec2(i * h, j * h)).value;
+            if (std::abs(v) < 1e-9) continue;
+            ++checked;
+            if (signs[k] != (v < 0.0 ? -1 : 1)) ++errors;
+        }
+    return errors;
+}
+
+}  // namespace
+
 TEST_CASE("validate and resolve FieldParams", "[field]") {
     FieldParams bad;
     bad.voxel_size = -1.0;
@@ -338,6 +408,11 @@ TEST_CASE("BoxSampler at z = 0 is the bilinear interpolant", "[field]") {
     for (int i = 0; i < 20000; ++i) pts.emplace_back(u(rng), u(rng));
     // OpenVDB interpolates in float; ours in double: equal to float rounding of values <= band.
     CHECK(detail::max_box_sampler_difference(*f, pts) <= 1e-7);
+    // Layers of a shared stack: the slab of each (its z plane, flood filled) is its field too.
+    const Scene stack = nested_stars(rng, 3, 300, 0.03);
+    const SceneFields fields(stack);
+    for (std::size_t i = 0; i < stack.size(); ++i)
+        CHECK(detail::max_box_sampler_difference(fields.field(i), pts) <= 1e-7);
 }
 
 TEST_CASE("grid agrees with the exact field: circles, sines, spiral", "[field]") {
@@ -560,4 +635,188 @@ TEST_CASE("SceneFields samples every layer", "[field]") {
     CHECK(st.leaves > 0);
     CHECK(st.active_voxels > 0);
     CHECK(st.memory_bytes > 0);
+}
+
+TEST_CASE("stacked grid: layers share leaves and keep their own planes", "[field]") {
+    std::mt19937 rng(41);
+    const Scene scene = nested_stars(rng, 3, 400, 0.03);
+    const SceneFields fields(scene);
+    const ResolvedFieldParams& p = fields.params();
+    REQUIRE(p.band_width > 0.03);  // neighbours are within the band of each other
+    CHECK(detail::shared_leaf_count(fields.field(0), fields.field(1)) > 10);
+    CHECK(detail::shared_leaf_count(fields.field(0), fields.field(2)) > 0);
+    const FieldStats total = fields.total_stats();
+    std::size_t sum_leaves = 0, sum_bytes = 0, sum_active = 0;
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+        const FieldStats st = fields.field(i).stats();
+        sum_leaves += st.leaves;
+        sum_bytes += st.memory_bytes;
+        sum_active += st.active_voxels;
+        // Some leaves of the stack hold no band voxel of layer i: its plane there is uniform.
+        CHECK(st.leaves < total.leaves);
+    }
+    CHECK(total.leaves < sum_leaves);  // shared leaves are counted once
+    CHECK(total.active_voxels == sum_active);
+    // Each layer's share of the grid is rounded down: the total is at most one byte per layer
+    // more than the sum.
+    CHECK(sum_bytes <= total.memory_bytes);
+    CHECK(total.memory_bytes - sum_bytes <= scene.size());
+    CHECK(total.segments == 3 * 400);
+
+    // A closed layer's field does not depend on the layers it shares the grid with: bit for bit
+    // the field of a stack of one, everywhere (band values, spread and uniform planes, tiles).
+    const std::vector<Vec2> qs = scene_queries(scene, p.band_width, 20000, 5);
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+        const auto alone = make_field(scene.layer(i), 1, p);
+        std::size_t differ = 0, in_band = 0;
+        for (const Vec2& x : qs) {
+            const FieldSample a = fields.field(i).sample(x), b = alone->sample(x);
+            if (!same_sample(a, b)) ++differ;
+            in_band += a.in_band ? 1u : 0u;
+        }
+        INFO("layer " << i);
+        CHECK(differ == 0);
+        CHECK(in_band > 1000);
+    }
+
+    // Every voxel of every plane (band, spread, uniform, out of every leaf) has the exact sign.
+    Box2 box;
+    for (const Layer& l : scene.layers()) box.extend(l.bounds());
+    box = box.inflated(5.0 * p.band_width);
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+        const auto exact =
+            make_field(scene.layer(i), 1, with_backend(p, FieldBackend::ExactIndexed));
+        std::size_t checked = 0;
+        CHECK(voxel_sign_errors(fields.field(i), *exact, box, p.voxel_size, checked) == 0);
+        CHECK(checked > 10000);
+    }
+}
+
+TEST_CASE("stacked grid: sample_all equals every layer's sample", "[field]") {
+    std::mt19937 rng(43);
+    for (std::size_t count : {1u, 3u, 9u}) {
+        const Scene scene = nested_stars(rng, count, 200, 0.02);
+        for (FieldBackend b : {FieldBackend::Grid, FieldBackend::ExactIndexed}) {
+            FieldParams fp;
+            fp.backend = b;
+            const SceneFields fields(scene, fp);
+            std::vector<FieldSample> all;
+            std::size_t differ = 0, in_band = 0;
+            for (const Vec2& x : scene_queries(scene, fields.params().band_width, 6000, 9)) {
+                fields.sample_all(x, all);
+                REQUIRE(all.size() == count);
+                for (std::size_t i = 0; i < count; ++i) {
+                    if (!same_sample(all[i], fields.field(i).sample(x))) ++differ;
+                    in_band += all[i].in_band ? 1u : 0u;
+                }
+            }
+            INFO(count << " layers, backend " << static_cast<int>(b));
+            CHECK(differ == 0);
+            CHECK(in_band > 500);
+        }
+    }
+}
+
+TEST_CASE("stacked grid: 9 layers span two leaf rows", "[field]") {
+    // Layers 0-7 in the leaves of z in [0, 8), layer 8 alone in the row z in [8, 16).
+    std::mt19937 rng(47);
+    const Scene scene = nested_stars(rng, 9, 300, 0.02);
+    const SceneFields fields(scene);
+    const ResolvedFieldParams& p = fields.params();
+    CHECK(detail::shared_leaf_count(fields.field(7), fields.field(8)) == 0);  // other rows
+    CHECK(detail::shared_leaf_count(fields.field(6), fields.field(7)) > 0);
+    Box2 box;
+    for (const Layer& l : scene.layers()) box.extend(l.bounds());
+    box = box.inflated(5.0 * p.band_width);
+    const std::vector<Vec2> qs = scene_queries(scene, p.band_width, 4000, 3);
+    for (std::size_t i : {0u, 7u, 8u}) {
+        INFO("layer " << i);
+        const auto exact =
+            make_field(scene.layer(i), 1, with_backend(p, FieldBackend::ExactIndexed));
+        std::size_t checked = 0;
+        CHECK(voxel_sign_errors(fields.field(i), *exact, box, p.voxel_size, checked) == 0);
+        const auto alone = make_field(scene.layer(i), 1, p);
+        std::size_t differ = 0;
+        for (const Vec2& x : qs)
+            if (!same_sample(fields.field(i).sample(x), alone->sample(x))) ++differ;
+        CHECK(differ == 0);
+    }
+}
+
+TEST_CASE("stacked grid: updates of several layers equal a rebuild of the scene", "[field]") {
+    std::mt19937 rng(53);
+    for (std::size_t count : {3u, 9u}) {
+        Scene scene = nested_stars(rng, count, 300, 0.02);
+        // One open layer in the stack too: a graph through the stars.
+        std::vector<Layer> layers = scene.layers();
+        Layer graph = random_graph(rng, 200);
+        for (Vec2& q : graph.points) q += Vec2(-2.0, 0.1);
+        layers.insert(layers.begin() + 1, graph);
+        scene = Scene(layers);
+        SceneFields fields(scene);
+        const FieldParams fixed = [&] {
+            FieldParams fp;
+            fp.voxel_size = fields.params().voxel_size;
+            fp.band_width = fields.params().band_width;
+            fp.bucket_size = fields.params().bucket_size;
+            return fp;
+        }();
+        REQUIRE(detail::shared_leaf_count(fields.field(0), fields.field(2)) > 0);
+        std::uniform_int_distribution<std::size_t> pick(0, scene.size() - 1);
+        for (int step = 0; step < 120; ++step) {
+            const std::size_t l = pick(rng);
+            std::vector<Vec2> pts = scene.layer(l).points;
+            const PolylineEdit edit = random_edit(rng, pts, 0.008);
+            fields.field(l).update(pts, edit);
+            layers[l].points = pts;
+            scene = Scene(layers);
+            if (step % 30 != 29) continue;
+            const SceneFields fresh(scene, fixed);
+            for (std::size_t i = 0; i < scene.size(); ++i) {
+                std::string why;
+                const bool same = detail::grids_identical(fields.field(i), fresh.field(i), &why);
+                INFO(count << " stars, step " << step << ", layer " << i << ": " << why);
+                CHECK(same);
+            }
+            CHECK(fields.total_stats().leaves == fresh.total_stats().leaves);
+            CHECK(fields.total_stats().active_voxels == fresh.total_stats().active_voxels);
+        }
+        CHECK(detail::shared_leaf_count(fields.field(0), fields.field(2)) > 0);
+    }
+}
+
+TEST_CASE("stacked grid: a layer swept across others' leaves updates its planes there", "[field]") {
+    // Layer 2 dented deep through layers 0 and 1 (which share leaves) and back, then pushed out
+    // into empty space: its uniform planes in their leaves flip sign far from its band (inside
+    // the loop of the old and new chains), leaves are created (the other layers' planes signed
+    // there) and removed again.
+    std::vector<Layer> layers = test::nested_circles(2, 256, 1.0, 0.05).layers();
+    Layer outer = test::nested_circles(1, 256, 1.3).layer(0);
+    outer.name = "outer";
+    layers.push_back(outer);
+    Scene scene(layers);
+    SceneFields fields(scene);
+    FieldParams fixed;
+    fixed.voxel_size = fields.params().voxel_size;
+    fixed.band_width = fields.params().band_width;
+    fixed.bucket_size = fields.params().bucket_size;
+    REQUIRE(detail::shared_leaf_count(fields.field(0), fields.field(1)) > 10);
+    REQUIRE(0.25 > 2.0 * fields.params().band_width);
+    const std::size_t first = 10, count = 21;
+    for (double radius : {0.55, 1.3, 1.9, 1.3}) {
+        for (std::size_t k = first; k < first + count; ++k)
+            layers[2].points[k] = outer.points[k] * (radius / 1.3);
+        scene = Scene(layers);
+        fields.field(2).update(scene.layer(2).points, {first, count, count});
+        const SceneFields fresh(scene, fixed);
+        for (std::size_t i = 0; i < 3; ++i) {
+            std::string why;
+            const bool same = detail::grids_identical(fields.field(i), fresh.field(i), &why);
+            INFO("radius " << radius << ", layer " << i << ": " << why);
+            CHECK(same);
+        }
+        // Inside the dent, on layer 0's curve: outside layer 2 (positive) when dented.
+        const Vec2 probe = scene.layer(0).points[first + count / 2];
+        CHECK((fields.field(2).sample(probe).value > 0.0) == (radius < 1.0));
+    }
 }

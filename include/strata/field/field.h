@@ -93,15 +93,21 @@ struct PolylineEdit {
     std::size_t inserted = 0;
 };
 
-/// Size and extent of a field's storage.
+/// Size and extent of a field's storage (LayerField::stats(): one layer;
+/// SceneFields::total_stats(): the scene).
 struct FieldStats {
-    std::size_t segments = 0;       ///< Segments of the layer.
-    std::size_t memory_bytes = 0;   ///< Grid (OpenVDB memUsage) + segment store + index.
-    std::size_t active_voxels = 0;  ///< Grid only: band voxels.
-    std::size_t leaves = 0;         ///< Grid only: 8x8x8 leaf nodes.
-    Box2 bounds;                    ///< Grid: active voxel bounding box; exact: layer bounds.
-    double voxel_size = 0.0;        ///< Scene units (0 for exact backends).
-    double band_width = 0.0;        ///< Scene units.
+    std::size_t segments = 0;  ///< Segments of the layer.
+    /// Segment store + bucket index of the layer; Grid: plus its share of the grid that all
+    /// layers of a SceneFields share (OpenVDB memUsage x the layer's fraction of the band
+    /// voxels). SceneFields::total_stats() counts the shared grid once.
+    std::size_t memory_bytes = 0;
+    std::size_t active_voxels = 0;  ///< Grid only: band voxels of the layer.
+    /// Grid only: 8x8x8 leaf nodes holding band voxels of the layer (they may hold other layers'
+    /// too); total_stats(): leaves of the shared grid.
+    std::size_t leaves = 0;
+    Box2 bounds;              ///< Grid: active voxel bounding box; exact: layer bounds.
+    double voxel_size = 0.0;  ///< Scene units (0 for exact backends).
+    double band_width = 0.0;  ///< Scene units.
 };
 
 /// @brief The signed distance field of one layer (see the file comment for the convention).
@@ -154,7 +160,14 @@ class LayerField {
 std::unique_ptr<LayerField> make_field(const Layer& layer, int outside_sign,
                                        const ResolvedFieldParams& params);
 
+namespace detail {
+class GridStack;
+}
+
 /// @brief One field per layer of a scene, built with the same resolved parameters.
+/// Grid backend: the layers share one grid (layer i at index z = i); each field reads and
+/// updates its own plane of it, so the fields of one SceneFields must not be updated while
+/// another of them is sampled (see LayerField: update() is not thread safe).
 class SceneFields {
   public:
     /// Builds every layer's field; open layers take their outside side from `outside_signs`
@@ -168,11 +181,18 @@ class SceneFields {
     LayerField& field(std::size_t i) { return *fields_.at(i); }
     const ResolvedFieldParams& params() const { return params_; }
 
-    /// Every layer's sample at `x`, in layer order (resized to size()).
+    /// Every layer's sample at `x`, in layer order (resized to size()); equal to each field's
+    /// sample(x). Grid backend: one grid probe per bilinear corner serves 8 layers.
     void sample_all(const Vec2& x, std::vector<FieldSample>& out) const;
+
+    /// Totals over the layers: segments, band voxels, memory (the shared grid counted once, plus
+    /// every layer's segment store and index), leaves of the shared grid (Grid), union of the
+    /// bounds; voxel size and band width.
+    FieldStats total_stats() const;
 
   private:
     ResolvedFieldParams params_;
+    std::shared_ptr<detail::GridStack> grid_;  // Grid backend: the grid fields_ share
     std::vector<std::unique_ptr<LayerField>> fields_;
 };
 
