@@ -820,3 +820,66 @@ TEST_CASE("stacked grid: a layer swept across others' leaves updates its planes 
         CHECK((fields.field(2).sample(probe).value > 0.0) == (radius < 1.0));
     }
 }
+
+TEST_CASE("out-of-band signs are exact past one 4096-voxel root node", "[field]") {
+    // A square 10000 voxels wide: its centre lies in no root child (no leaf within 4096
+    // voxels), which a flood fill of the internal nodes could not sign.
+    const Layer square =
+        make_layer({{0, 0}, {10000, 0}, {10000, 10000}, {0, 10000}}, true, "square");
+    const auto f = make_field(square, 1, explicit_params(1.0, 3.0));
+    for (const Vec2& x : {Vec2(5000.5, 5000.5), Vec2(100.25, 9000.0), Vec2(9990.0, 20.0)})
+        CHECK(f->sample(x).value == -3.0);
+    for (const Vec2& x : {Vec2(-5000.0, 5000.0), Vec2(15000.0, 5000.0), Vec2(5000.0, 20000.0)})
+        CHECK(f->sample(x).value == 3.0);
+    std::vector<int> signs;
+    std::vector<char> active;
+    detail::voxel_signs(*f, -20, 10020, 5000, 5000, signs, active);
+    std::size_t wrong = 0;
+    for (std::size_t k = 0; k < signs.size(); ++k) {
+        const int i = -20 + static_cast<int>(k);
+        if (i != 0 && i != 10000 && signs[k] != (i > 0 && i < 10000 ? -1 : 1)) ++wrong;
+    }
+    CHECK(wrong == 0);
+}
+
+TEST_CASE("stacked grid: a real 9-layer slice with an open layer", "[field]") {
+    // Body, suit (one open piece) and six small loops far from them: layers 0-7 in the first leaf
+    // row, layer 8 in the second.
+    Scene scene = read_scene_json(test::test_data("slices/mh_casualsuit03_y+1.50.json"));
+    REQUIRE(scene.size() == 9);
+    SceneFields fields(scene);
+    const ResolvedFieldParams& p = fields.params();
+    const std::vector<Vec2> qs = scene_queries(scene, p.band_width, 20000, 13);
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+        INFO("layer " << scene.layer(i).name);
+        const auto alone = make_field(scene.layer(i), 1, p);
+        std::size_t differ = 0;
+        for (const Vec2& x : qs) {
+            const FieldSample a = fields.field(i).sample(x), b = alone->sample(x);
+            // An open layer's sign out of its band carries no information: band samples only.
+            if (scene.layer(i).closed ? !same_sample(a, b)
+                                      : a.in_band != b.in_band || (a.in_band && !same_sample(a, b)))
+                ++differ;
+        }
+        CHECK(differ == 0);
+    }
+    FieldParams fixed;
+    fixed.voxel_size = p.voxel_size;
+    fixed.band_width = p.band_width;
+    fixed.bucket_size = p.bucket_size;
+    std::mt19937 rng(59);
+    std::vector<Layer> layers = scene.layers();
+    for (int step = 0; step < 60; ++step) {
+        const std::size_t l = static_cast<std::size_t>(step) % 3;  // body, suit, open suit piece
+        const PolylineEdit edit = random_edit(rng, layers[l].points, 0.2 * p.band_width);
+        fields.field(l).update(layers[l].points, edit);
+    }
+    scene = Scene(layers);
+    const SceneFields fresh(scene, fixed);
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+        std::string why;
+        const bool same = detail::grids_identical(fields.field(i), fresh.field(i), &why);
+        INFO("layer " << scene.layer(i).name << ": " << why);
+        CHECK(same);
+    }
+}
