@@ -1,12 +1,11 @@
 // Field backends side by side: build time, memory per segment, value+gradient queries per
 // second (random near the curve and curve-ordered), localized update time (one vertex moved by
-// a fixed distance: the same box at every size). Then the grid layouts: per-layer z = 0 slabs
-// against one layer-stacked grid (z = layer index) on 5- and 8-layer stacked scenes.
+// a fixed distance: the same box at every size). Then the grid layouts: the production
+// layer-stacked grid of SceneFields (z = layer index) against one z = 0 slab field per layer,
+// on 1-, 5- and 8-layer stacked scenes.
 // Plain timing main; prints two tables. Usage: strata_bench_field [max_segments]
 
 #include "strata/field/field.h"
-
-#include <openvdb/openvdb.h>
 
 #include <chrono>
 #include <cmath>
@@ -41,52 +40,13 @@ Layer wavy_circle(std::size_t n, double offset = 0.0) {
     return layer;
 }
 
-using Tree = openvdb::FloatTree;
-using Accessor = openvdb::tree::ValueAccessor<const Tree, false>;
-
-/// The grid's voxels of one layer: exact signed values (ExactIndexed) at the voxel centres
-/// within the band, as the Grid backend stores them (visited segment by segment, band boxes).
-template <typename F>
-void for_band_voxels(const Layer& layer, const LayerField& exact, const ResolvedFieldParams& p,
-                     F&& f) {
-    const double h = p.voxel_size;
-    openvdb::BoolTree visited(false);
-    openvdb::tree::ValueAccessor<openvdb::BoolTree> seen(visited);
-    for (std::size_t s = 0; s < layer.segment_count(); ++s) {
-        Box2 box;
-        box.extend(layer.segment_start(s));
-        box.extend(layer.segment_end(s));
-        box = box.inflated(p.band_width);
-        const int i0 = static_cast<int>(std::ceil(box.min.x / h));
-        const int i1 = static_cast<int>(std::floor(box.max.x / h));
-        const int j0 = static_cast<int>(std::ceil(box.min.y / h));
-        const int j1 = static_cast<int>(std::floor(box.max.y / h));
-        for (int i = i0; i <= i1; ++i)
-            for (int j = j0; j <= j1; ++j) {
-                const openvdb::Coord c(i, j, 0);
-                if (seen.isValueOn(c)) continue;
-                seen.setValueOn(c, true);
-                const FieldSample v = exact.sample(Vec2(i * h, j * h));
-                if (v.in_band) f(i, j, static_cast<float>(v.value));
-            }
-    }
-}
-
-/// Bilinear sample from the 4 corner values (as the Grid backend does).
-FieldSample bilinear(const float v[4], bool on, double fx, double fy, double h) {
-    FieldSample out;
-    const double d00 = v[0], d10 = v[1], d01 = v[2], d11 = v[3];
-    out.value = (1.0 - fy) * ((1.0 - fx) * d00 + fx * d10) + fy * ((1.0 - fx) * d01 + fx * d11);
-    out.gradient = Vec2(((1.0 - fy) * (d10 - d00) + fy * (d11 - d01)) / h,
-                        ((1.0 - fx) * (d01 - d00) + fx * (d11 - d10)) / h);
-    out.in_band = on;
-    return out;
-}
-
-/// Per-layer slabs (z = 0, one tree per layer) against one stacked tree (z = layer index) on a
-/// scene of `layers` concentric wavy curves `gap` apart: grid memory (OpenVDB memUsage; the
-/// segment stores and leaf buckets are the same for both layouts) and the time of sampling
-/// every layer at a point (what SceneFields::sample_all does).
+/// The layouts of the Grid backend on a scene of `layers` concentric wavy curves `gap` apart:
+/// the production SceneFields (one layer-stacked grid, layer i at z = i) against one field per
+/// layer built alone (make_field: a stack of one, i.e. a z = 0 slab per layer, with its own
+/// segment store and index). Memory: FieldStats (grid memUsage + segment stores + bucket
+/// indexes); "grid" subtracts the stores and indexes (an ExactIndexed SceneFields of the same
+/// scene holds the same ones). sample_all: every layer at a point near a random layer.
+/// Update: one vertex of layer u % layers moved by (0.1, -0.05), 200 spread moves, mean.
 void bench_layout(std::size_t layers, std::size_t n, double gap) {
     std::vector<Layer> ls;
     for (std::size_t k = 0; k < layers; ++k) {
@@ -95,34 +55,26 @@ void bench_layout(std::size_t layers, std::size_t n, double gap) {
     }
     const Scene scene(ls);
     const ResolvedFieldParams p = resolve({}, scene);
-    const float bg = static_cast<float>(p.band_width);
-    std::vector<Tree::Ptr> slabs;
-    const auto stacked = std::make_shared<Tree>(bg);
     std::size_t segments = 0;
-    for (std::size_t k = 0; k < layers; ++k) {
-        ResolvedFieldParams e = p;
-        e.backend = FieldBackend::ExactIndexed;
-        const auto exact = make_field(ls[k], 1, e);
-        segments += ls[k].segment_count();
-        auto slab = std::make_shared<Tree>(bg);
-        const int z = static_cast<int>(k);
-        for_band_voxels(ls[k], *exact, p, [&](int i, int j, float v) {
-            slab->setValueOn(openvdb::Coord(i, j, 0), v);
-            stacked->setValueOn(openvdb::Coord(i, j, z), v);
-        });
-        slabs.push_back(slab);
-    }
+    for (const Layer& l : ls) segments += l.segment_count();
+
+    auto t0 = Clock::now();
+    SceneFields stacked(scene);
+    const double stacked_build = seconds_since(t0);
+    t0 = Clock::now();
+    std::vector<std::unique_ptr<LayerField>> slabs;
+    for (const Layer& l : ls) slabs.push_back(make_field(l, 1, p));
+    const double slab_build = seconds_since(t0);
+    FieldParams ep;
+    ep.backend = FieldBackend::ExactIndexed;
+    const std::size_t index_bytes = SceneFields(scene, ep).total_stats().memory_bytes;
+    const FieldStats total = stacked.total_stats();
     std::size_t slab_bytes = 0, slab_leaves = 0;
-    for (const auto& t : slabs) {
-        slab_bytes += static_cast<std::size_t>(t->memUsage());
-        slab_leaves += static_cast<std::size_t>(t->leafCount());
+    for (const auto& f : slabs) {
+        const FieldStats st = f->stats();
+        slab_bytes += st.memory_bytes;
+        slab_leaves += st.leaves;
     }
-    const auto stacked_bytes = static_cast<std::size_t>(stacked->memUsage());
-    // Production fields of the same scene (slab layout): total bytes incl. stores and buckets.
-    const SceneFields fields(scene);
-    std::size_t field_bytes = 0;
-    for (std::size_t k = 0; k < fields.size(); ++k)
-        field_bytes += fields.field(k).stats().memory_bytes;
 
     std::mt19937 rng(3);
     std::uniform_int_distribution<std::size_t> pick(0, n - 1);
@@ -132,73 +84,70 @@ void bench_layout(std::size_t layers, std::size_t n, double gap) {
         const Layer& l = ls[static_cast<std::size_t>(q) % layers];
         qs.push_back(l.points[pick(rng)] + Vec2(off(rng), off(rng)));
     }
-    const double h = p.voxel_size;
-    std::vector<FieldSample> out(layers);
+    std::vector<FieldSample> out(layers), other(layers);
     double sink = 0.0;
+    std::size_t differ = 0;  // closed layers: both layouts give the same samples
     const auto time_it = [&](auto&& sample_all) {
         const auto start = Clock::now();
         for (const Vec2& x : qs) {
-            sample_all(x);
+            sample_all(x, out);
             sink += out[0].value + out[layers - 1].gradient.x;
         }
         return static_cast<double>(qs.size()) / seconds_since(start);
     };
-    std::vector<Accessor> slab_acc;
-    for (const auto& t : slabs) slab_acc.emplace_back(*t);
-    const double slab_rate = time_it([&](const Vec2& x) {
-        const double gx = x.x / h, gy = x.y / h, fx0 = std::floor(gx), fy0 = std::floor(gy);
-        const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
-        for (std::size_t k = 0; k < layers; ++k) {
-            float v[4];
-            bool on = true;
-            for (int c = 0; c < 4; ++c)
-                on &= slab_acc[k].probeValue(openvdb::Coord(i0 + (c & 1), j0 + (c >> 1), 0), v[c]);
-            out[k] = bilinear(v, on, gx - fx0, gy - fy0, h);
-        }
+    const double stacked_rate =
+        time_it([&](const Vec2& x, std::vector<FieldSample>& o) { stacked.sample_all(x, o); });
+    const double slab_rate = time_it([&](const Vec2& x, std::vector<FieldSample>& o) {
+        for (std::size_t k = 0; k < layers; ++k) o[k] = slabs[k]->sample(x);
     });
-    Accessor stacked_acc(*stacked);
-    const double stacked_rate = time_it([&](const Vec2& x) {
-        const double gx = x.x / h, gy = x.y / h, fx0 = std::floor(gx), fy0 = std::floor(gy);
-        const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
-        // One leaf access per corner returns every layer's value there.
-        const Tree::LeafNodeType* leaf[4];
-        for (int c = 0; c < 4; ++c)
-            leaf[c] = stacked_acc.probeConstLeaf(openvdb::Coord(i0 + (c & 1), j0 + (c >> 1), 0));
+    for (std::size_t q = 0; q < qs.size(); q += 7) {
+        stacked.sample_all(qs[q], other);
         for (std::size_t k = 0; k < layers; ++k) {
-            float v[4];
-            bool on = true;
-            for (int c = 0; c < 4; ++c) {
-                const openvdb::Coord xyz(i0 + (c & 1), j0 + (c >> 1), static_cast<int>(k));
-                if (leaf[c] != nullptr) {
-                    const openvdb::Index o = Tree::LeafNodeType::coordToOffset(xyz);
-                    v[c] = leaf[c]->getValue(o);
-                    on &= leaf[c]->isValueOn(o);
-                } else {
-                    on &= stacked_acc.probeValue(xyz, v[c]);
-                }
-            }
-            out[k] = bilinear(v, on, gx - fx0, gy - fy0, h);
+            const FieldSample s = slabs[k]->sample(qs[q]);
+            if (s.value != other[k].value || s.gradient != other[k].gradient ||
+                s.in_band != other[k].in_band)
+                ++differ;
         }
-    });
+    }
+    const auto time_updates = [&](auto&& field_of) {
+        std::vector<std::vector<Vec2>> pts;
+        for (const Layer& l : ls) pts.push_back(l.points);
+        const int updates = 200;
+        const auto start = Clock::now();
+        for (int u = 0; u < updates; ++u) {
+            const auto l = static_cast<std::size_t>(u) % layers;
+            const std::size_t i = 10 + static_cast<std::size_t>(u) * (n - 20) / updates;
+            pts[l][i] += Vec2(0.1, -0.05);
+            field_of(l).update(pts[l], {i, 1, 1});
+        }
+        return seconds_since(start) / updates;
+    };
+    const double stacked_update =
+        time_updates([&](std::size_t l) -> LayerField& { return stacked.field(l); });
+    const double slab_update =
+        time_updates([&](std::size_t l) -> LayerField& { return *slabs[l]; });
+
     const auto per_seg = [&](std::size_t bytes) {
         return static_cast<double>(bytes) / static_cast<double>(segments);
     };
-    std::printf("%-7zu %-9zu %-8s %12.0f %10zu %14.0f%s\n", layers, segments, "slab",
-                per_seg(slab_bytes), slab_leaves, slab_rate, sink == 12345.0 ? "!" : "");
-    std::printf("%-7zu %-9zu %-8s %12.0f %10zu %14.0f\n", layers, segments, "stacked",
-                per_seg(stacked_bytes), static_cast<std::size_t>(stacked->leafCount()),
-                stacked_rate);
-    std::printf(
-        "  (gap %g, h = %g, band = %g; production slab fields incl. segment stores and "
-        "buckets: %.0f bytes/segment)\n",
-        gap, h, p.band_width, per_seg(field_bytes));
+    const auto row = [&](const char* layout, std::size_t bytes, std::size_t leaves, double build,
+                         double rate, double update) {
+        std::printf("%-7zu %-9zu %-8s %10.0f %10.0f %9zu %10.1f %13.0f %10.1f\n", layers, segments,
+                    layout, per_seg(bytes), per_seg(bytes - index_bytes), leaves, build * 1e3, rate,
+                    update * 1e6);
+    };
+    row("slabs", slab_bytes, slab_leaves, slab_build, slab_rate, slab_update);
+    row("stacked", total.memory_bytes, total.leaves, stacked_build, stacked_rate, stacked_update);
+    std::printf("  (gap %g, h = %g, band = %g; stores + indexes %.0f bytes/segment%s)\n", gap,
+                p.voxel_size, p.band_width, per_seg(index_bytes),
+                differ == 0 ? "" : "; LAYOUTS DIFFER");
+    if (sink == 12345.0) std::printf("!\n");
 }
 
 void bench_layouts() {
-    openvdb::initialize();
-    std::printf("\n%-7s %-9s %-8s %12s %10s %14s\n", "layers", "segments", "layout", "grid B/seg",
-                "leaves", "sample_all/s");
-    for (std::size_t layers : {5u, 8u}) bench_layout(layers, 10000, 0.5);
+    std::printf("\n%-7s %-9s %-8s %10s %10s %9s %10s %13s %10s\n", "layers", "segments", "layout",
+                "bytes/seg", "grid B/seg", "leaves", "build ms", "sample_all/s", "update us");
+    for (std::size_t layers : {1u, 5u, 8u}) bench_layout(layers, 10000, 0.5);
 }
 
 }  // namespace
