@@ -514,6 +514,15 @@ class GridStack {
         // Every segment within band of a voxel centre has a point in the box inflated by the
         // band (one more voxel against rounding), so it is listed in a bucket the box touches.
         d.index.candidates(box.inflated(band_ + h_), ids);
+        // Only those whose box inflated by the band reaches a voxel centre (a margin against
+        // rounding): the offers below dominate the build.
+        const double reach = band_ + 1e-3 * h_;
+        ids.erase(
+            std::remove_if(ids.begin(), ids.end(),
+                           [&](std::uint32_t s) {
+                               return !d.store.segments()[s].box().inflated(reach).overlaps(box);
+                           }),
+            ids.end());
         if (ids.empty()) return false;
         std::array<int, kPlane> sign{};
         const double band2 = band_ * band_;
