@@ -33,11 +33,16 @@ namespace strata::detail {
 
 namespace {
 
-using Tree = openvdb::FloatTree;
+// Internal nodes of 16^3 and 8^3 children (1024^3 and 64^3 voxels) instead of OpenVDB's default
+// 32^3 and 16^3 (4096^3 and 128^3): the layers fill one leaf row along z, so most of an internal
+// node's table is empty; the smaller tables hold less of that (docs/field.md). The leaves are the
+// standard 8^3 ones, and the .vdb files hold standard FloatGrids (write_vdb extracts slabs).
+using Tree = openvdb::tree::Tree4<float, 4, 3, 3>::Type;
+using StackGrid = openvdb::Grid<Tree>;
 using Leaf = Tree::LeafNodeType;
 using ConstAccessor = openvdb::tree::ValueAccessor<const Tree, false>;
-using N2 = Tree::RootNodeType::ChildNodeType;  // 4096^3 voxels
-using N1 = N2::ChildNodeType;                  // 128^3 voxels
+using N2 = Tree::RootNodeType::ChildNodeType;  // 1024^3 voxels
+using N1 = N2::ChildNodeType;                  // 64^3 voxels
 
 constexpr int kLeafDim = 8;                  // voxels per leaf side; layers per leaf row
 constexpr int kPlane = kLeafDim * kLeafDim;  // voxels of one z plane of a leaf
@@ -452,8 +457,9 @@ class GridStack {
             const openvdb::Coord xyz(static_cast<int>(x), j, z);
             if (const Leaf* leaf = acc.probeConstLeaf(xyz))
                 return leaf->getValue(Leaf::coordToOffset(xyz)) < 0.f ? -bg : bg;
-            const int depth = acc.getValueDepth(xyz);  // 2: leaf-sized tile, 1: 128, else 4096
-            const long span = depth == 2 ? 8 : (depth == 1 ? 128 : 4096);
+            const int depth = acc.getValueDepth(xyz);  // 2: leaf-sized tile, 1: N1, else N2
+            const long span = depth == 2 ? static_cast<long>(Leaf::DIM)
+                                         : static_cast<long>(depth == 1 ? N1::DIM : N2::DIM);
             x = (floor_div(x, span) + 1) * span;
         }
         return bg;
@@ -607,7 +613,7 @@ class GridStack {
     // Full build: per row, the leaves any of its layers reaches, computed in parallel (one task
     // per leaf), inserted serially.
     void build() {
-        auto grid = openvdb::FloatGrid::create(static_cast<float>(band_));
+        auto grid = StackGrid::create(static_cast<float>(band_));
         grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
         grid->setGridClass(openvdb::GRID_LEVEL_SET);
         grid->setName("strata_layers");
@@ -725,14 +731,14 @@ class GridStack {
                 root_tiles = true;
             }
         }
-        // A fresh build has no root tiles; rare (a 4096-voxel node emptied), O(root children).
+        // A fresh build has no root tiles; rare (a 1024-voxel node emptied), O(root children).
         if (root_tiles) tree.root().eraseBackgroundTiles();
     }
 
     double h_ = 1.0;
     double band_ = 1.0;
     std::vector<LayerData> layers_;
-    openvdb::FloatGrid::Ptr grid_;
+    StackGrid::Ptr grid_;
     std::size_t leaf_count_ = 0;
     long max_leaf_x_ = std::numeric_limits<long>::min();  // >= every leaf's last voxel x
 };
@@ -882,7 +888,7 @@ bool grids_identical(const LayerField& fa, const LayerField& fb, std::string* wh
 double max_box_sampler_difference(const LayerField& field, const std::vector<Vec2>& points) {
     const GridField& g = as_grid(field, "max_box_sampler_difference");
     const openvdb::FloatGrid::Ptr slab = g.stack().slab(g.layer());
-    ConstAccessor acc(slab->tree());
+    const openvdb::FloatGrid::ConstAccessor acc = slab->getConstAccessor();
     const double h = g.stack().voxel_size();
     double worst = 0.0;
     for (const Vec2& p : points) {

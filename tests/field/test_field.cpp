@@ -821,9 +821,10 @@ TEST_CASE("stacked grid: a layer swept across others' leaves updates its planes 
     }
 }
 
-TEST_CASE("out-of-band signs are exact past one 4096-voxel root node", "[field]") {
-    // A square 10000 voxels wide: its centre lies in no root child (no leaf within 4096
-    // voxels), which a flood fill of the internal nodes could not sign.
+TEST_CASE("out-of-band signs are exact far from every leaf", "[field]") {
+    // A square 10000 voxels wide: its centre lies in no root child (no leaf within one root
+    // child's 1024 voxels, nor within the 4096 of OpenVDB's default tree), which a flood fill
+    // of the internal nodes could not sign.
     const Layer square =
         make_layer({{0, 0}, {10000, 0}, {10000, 10000}, {0, 10000}}, true, "square");
     const auto f = make_field(square, 1, explicit_params(1.0, 3.0));
