@@ -12,16 +12,26 @@
 
 using namespace strata;
 
+namespace {
+
+// Every grid of the .vdb file at `path`, read with OpenVDB's own reader.
+openvdb::GridPtrVecPtr read_grids(const std::filesystem::path& path) {
+    openvdb::initialize();
+    openvdb::io::File file(path.string());
+    file.open();
+    openvdb::GridPtrVecPtr grids = file.getGrids();
+    file.close();
+    return grids;
+}
+
+}  // namespace
+
 TEST_CASE("write_vdb writes one grid per layer that OpenVDB reads back", "[field][io]") {
     const Scene scene = test::nested_circles(2, 128);
     const SceneFields fields(scene);
     const auto path = std::filesystem::temp_directory_path() / "strata_test_fields.vdb";
     write_vdb(scene, fields, path);
-    openvdb::initialize();
-    openvdb::io::File file(path.string());
-    file.open();
-    const openvdb::GridPtrVecPtr grids = file.getGrids();
-    file.close();
+    const openvdb::GridPtrVecPtr grids = read_grids(path);
     REQUIRE(grids->size() == 2);
     for (std::size_t i = 0; i < 2; ++i) {
         const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>((*grids)[i]);
@@ -50,11 +60,7 @@ TEST_CASE("write_vdb extracts every layer of a 9-layer stacked grid as a z = 0 s
     const SceneFields fields(scene);
     const auto path = std::filesystem::temp_directory_path() / "strata_test_fields9.vdb";
     write_vdb(scene, fields, path);
-    openvdb::initialize();
-    openvdb::io::File file(path.string());
-    file.open();
-    const openvdb::GridPtrVecPtr grids = file.getGrids();
-    file.close();
+    const openvdb::GridPtrVecPtr grids = read_grids(path);
     std::filesystem::remove(path);
     REQUIRE(grids->size() == 9);
     const double h = fields.params().voxel_size;
