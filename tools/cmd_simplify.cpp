@@ -107,11 +107,12 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
         r.nesting_violations);
     std::printf(
         "min separation ratio %.4g; max Hausdorff %.4g; removals %zu, set aside %zu, untangled "
-        "%zu in %zu batches, refused %zu (%zu gave up early); time %.3f s (decimate %.3f, fields %.3f, untangle "
+        "%zu in %zu batches, refused %zu (%zu gave up early); time %.3f s (decimate %.3f, fields "
+        "%.3f, untangle "
         "%.3f, check %.3f)\n",
         r.min_separation_ratio, max_hausdorff(r), r.removed, r.deferred, r.untangle_calls,
-        r.batches, r.refused, r.gave_up, r.seconds_total, r.seconds_decimate, r.seconds_fields, r.seconds_untangle,
-        r.seconds_check);
+        r.batches, r.refused, r.gave_up, r.seconds_total, r.seconds_decimate, r.seconds_fields,
+        r.seconds_untangle, r.seconds_check);
     if (!r.collision_free)
         std::fprintf(
             stderr,

@@ -126,7 +126,8 @@ namespace {
 // Winding number of the closed polyline `k` around p, by winding_contribution().
 int winding_of(const std::vector<Vec2>& k, const Vec2& p) {
     int w = 0;
-    for (std::size_t i = 0; i < k.size(); ++i) w += winding_contribution(k[i], k[(i + 1) % k.size()], p);
+    for (std::size_t i = 0; i < k.size(); ++i)
+        w += winding_contribution(k[i], k[(i + 1) % k.size()], p);
     return w;
 }
 
@@ -142,7 +143,8 @@ TEST_CASE("winding_contribution sums to the winding number", "[predicates]") {
     CHECK(winding_of(ccw, {2, 0.0}) == 1);  // on the bottom edge: half-open rule, counted in
     CHECK(winding_of(ccw, {2, 3.0}) == 0);  // on the top edge: out
     // A loop going twice around.
-    const std::vector<Vec2> twice{{0, 0}, {4, 0}, {4, 3}, {0, 3}, {0.5, 0.5}, {3.5, 0.5}, {3.5, 2.5}, {0.5, 2.5}};
+    const std::vector<Vec2> twice{{0, 0},     {4, 0},     {4, 3},     {0, 3},
+                                  {0.5, 0.5}, {3.5, 0.5}, {3.5, 2.5}, {0.5, 2.5}};
     CHECK(winding_of(twice, {2, 1}) == 2);
     CHECK(winding_of(twice, {0.2, 1}) == 1);
 }
@@ -152,7 +154,8 @@ TEST_CASE("winding_change_across gives the winding change along a path", "[predi
     CHECK(winding_change_across({0, 1}, {2, 1}, {1, 0}, {1, 2}) == -1);
     CHECK(winding_change_across({0, 1}, {0.5, 1}, {1, 0}, {1, 2}) == 0);
     CHECK_FALSE(winding_change_across({0, 1}, {1, 1}, {1, 0}, {1, 2}).has_value());  // ends on it
-    CHECK_FALSE(winding_change_across({0, 0}, {2, 0}, {1, 0}, {1, 2}).has_value());  // through a's end
+    CHECK_FALSE(
+        winding_change_across({0, 0}, {2, 0}, {1, 0}, {1, 2}).has_value());  // through a's end
 
     // The identity the simplification driver's local nesting check relies on: when a stretch
     // of a closed polyline K0 moves (K1) and a point moves from p0 to p1,
@@ -191,7 +194,8 @@ TEST_CASE("winding_change_across gives the winding change along a path", "[predi
         for (std::size_t i = 0; i < n; ++i) {
             const std::size_t j = (i + 1) % n;
             if (!moved[i] && !moved[j]) continue;
-            delta += winding_contribution(k1[i], k1[j], p0) - winding_contribution(k0[i], k0[j], p0);
+            delta +=
+                winding_contribution(k1[i], k1[j], p0) - winding_contribution(k0[i], k0[j], p0);
         }
         bool degenerate = false;
         if (p1 != p0)

@@ -83,7 +83,7 @@ struct UntangleReport {
     std::size_t moved_vertices = 0;  ///< Vertices that moved by more than 1e-12 * diagonal.
     double max_displacement = 0.0;   ///< Largest distance of a vertex from its start, scene units.
     double mean_speed = 0.0;         ///< Last round's V (Eq. 7), scene units per step.
-    bool gave_up = false;  ///< Ended early by UntangleParams::give_up_when_stalled.
+    bool gave_up = false;            ///< Ended early by UntangleParams::give_up_when_stalled.
     std::size_t crossings_before = 0, crossings_after = 0;  ///< Between layers (check_scene).
     double min_separation_ratio_after = 0.0;  ///< check_scene's, +inf when nothing is required.
     double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
