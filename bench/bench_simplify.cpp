@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,7 +51,8 @@ Scene wavy_loops(std::size_t count, std::size_t points, double spacing) {
             const double a = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(points);
             const double r = radius + 0.15 * std::sin(waves * a);
             const double dr = 0.15 * waves * std::cos(waves * a);
-            const Vec2 tangent(dr * std::cos(a) - r * std::sin(a), dr * std::sin(a) + r * std::cos(a));
+            const Vec2 tangent(dr * std::cos(a) - r * std::sin(a),
+                               dr * std::sin(a) + r * std::cos(a));
             const Vec2 outward = glm::normalize(Vec2(tangent.y, -tangent.x));
             layer.points.push_back(Vec2(r * std::cos(a), r * std::sin(a)) +
                                    spacing * static_cast<double>(k) * outward);
@@ -116,10 +118,11 @@ void paper(std::size_t first, std::size_t last) {
                     converge ? "until converged" : "150 iterations", tg, tl, tg / tl,
                     rg.crossings_after, rl.crossings_after, rg.free_vertices, rl.free_vertices,
                     rg.rounds, rl.rounds, rg.passes, rl.passes);
-        std::printf("  phases (fields / untangle / check s): global %.3f / %.3f / %.3f, local %.3f / "
-                    "%.3f / %.3f\n",
-                    rg.seconds_fields, rg.seconds_untangle, rg.seconds_check, rl.seconds_fields,
-                    rl.seconds_untangle, rl.seconds_check);
+        std::printf(
+            "  phases (fields / untangle / check s): global %.3f / %.3f / %.3f, local %.3f / "
+            "%.3f / %.3f\n",
+            rg.seconds_fields, rg.seconds_untangle, rg.seconds_check, rl.seconds_fields,
+            rl.seconds_untangle, rl.seconds_check);
     }
 }
 
@@ -151,10 +154,9 @@ void scenes(const SceneFilter& filter) {
     std::printf(
         "%-6s %-7s %-5s %-8s %-9s %5s %3s %4s %8s %9s %7s %8s %8s %8s %8s %7s %7s %6s %5s %7s %9s "
         "%9s %6s %8s %9s %8s\n",
-        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "give", "naive s",
-        "strata s", "ratio", "us/step", "loop us", "deferred", "refused", "gave up", "untangl",
-        "jobs/b", "cross", "gap/req", "H naive", "H strata", "rss MB", "fields s", "untangle s",
-        "check s");
+        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "give", "naive s", "strata s",
+        "ratio", "us/step", "loop us", "deferred", "refused", "gave up", "untangl", "jobs/b",
+        "cross", "gap/req", "H naive", "H strata", "rss MB", "fields s", "untangle s", "check s");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
         for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
             if (filter.layers != 0 && count != filter.layers) continue;
@@ -209,14 +211,14 @@ void scenes(const SceneFilter& filter) {
                             const SimplifyReport r = simplify(s, params);
                             const double ts = now() - t;
                             std::printf(
-                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %4zu %8.3f %9.3f %7.1f %8.2f "
-                                "%8.2f %8zu %8zu %7zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f %6ld %8.3f "
-                                "%9.3f %8.3f\n",
+                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %4zu %8.3f %9.3f %7.1f "
+                                "%8.2f %8.2f %8zu %8zu %7zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f "
+                                "%6ld %8.3f %9.3f %8.3f\n",
                                 count, points, remove, name.c_str(), when.c_str(), params.batch,
-                                threads, give, tn,
-                                ts, ts / tn, 1e6 * ts / static_cast<double>(r.removed),
-                                1e6 * r.seconds_total / static_cast<double>(r.removed),
-                                r.deferred, r.refused, r.gave_up, r.untangle_calls,
+                                threads, give, tn, ts, ts / tn,
+                                1e6 * ts / static_cast<double>(r.removed),
+                                1e6 * r.seconds_total / static_cast<double>(r.removed), r.deferred,
+                                r.refused, r.gave_up, r.untangle_calls,
                                 r.batches ? static_cast<double>(r.untangle_calls) /
                                                 static_cast<double>(r.batches)
                                           : 0.0,
@@ -265,10 +267,22 @@ int main(int argc, char** argv) {
             } else if (key == "--batch") {
                 filter.batches = numbers(value);
             } else if (key == "--shape") {
+                if (value != "open" && value != "closed") {
+                    std::fprintf(stderr,
+                                 "strata_bench_simplify: --shape must be open or closed (got %s)\n",
+                                 value.c_str());
+                    return 2;
+                }
                 filter.closed = value == "closed";
             } else if (key == "--decimator") {
                 filter.decimator = value;
             } else if (key == "--give-up") {
+                if (value != "0" && value != "1" && value != "0,1" && value != "1,0") {
+                    std::fprintf(stderr,
+                                 "strata_bench_simplify: --give-up must be 0, 1 or 0,1 (got %s)\n",
+                                 value.c_str());
+                    return 2;
+                }
                 filter.give_up = numbers(value);
             } else if (key == "--schedule") {
                 filter.schedule = value;
@@ -279,13 +293,19 @@ int main(int argc, char** argv) {
                 return 2;
             }
         }
-        scenes(filter);
+        try {
+            scenes(filter);
+        } catch (const std::exception& e) {  // a bad --decimator, say
+            std::fprintf(stderr, "strata_bench_simplify: error: %s\n", e.what());
+            return 2;
+        }
     } else {
-        std::fprintf(stderr,
-                     "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
-                     "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
-                     "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
-                     "[--give-up 0,1] [--decimator random|visvalingam|max-error] [--shape open|closed]\n");
+        std::fprintf(
+            stderr,
+            "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
+            "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
+            "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
+            "[--give-up 0,1] [--decimator random|visvalingam|max-error] [--shape open|closed]\n");
         return 2;
     }
     return 0;
