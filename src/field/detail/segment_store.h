@@ -125,6 +125,7 @@ class SegmentStore {
         const Segment& s = segments_[slot];
         double t = 0.0;
         const double d2 = segment_dist2(s, x, t);
+        if (d2 > best.dist2) return;  // the usual case, without the out-of-line tie-break
         if (beats(d2, s, slot, best, segments_)) {
             best.dist2 = d2;
             best.slot = slot;
