@@ -30,8 +30,11 @@ struct UntangleParams {
     /// Interior points tested on each edge, at least (1 = the midpoint): a chord between two
     /// good vertices can still cut a neighbour. >= 0.
     int edge_samples = 1;
-    /// Longer edges get more points, one every `sample_spacing` (scene units, >= 0), so that a
-    /// neighbour's vertex poking through a long chord is seen; at most 64 per edge.
+    /// Longer edges get more points, one every 4 x `sample_spacing` (scene units, >= 0), plus
+    /// the feet of the other layers' vertices closer to the edge than the largest required
+    /// separation (at least min_separation) + 2 x `sample_spacing`, and than half the edge's
+    /// length, so that a neighbour's vertex poking through a long chord is seen; at most 64 of
+    /// each per edge.
     /// 0 = automatic: the smallest per-layer median segment length (the finest layer's detail).
     double sample_spacing = 0.0;
     ShapeMode shape = ShapeMode::ShapeMatching;  ///< Shape preservation between projections.
