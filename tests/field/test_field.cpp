@@ -75,6 +75,32 @@ double angle(const Vec2& a, const Vec2& b) {
     return std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0));
 }
 
+/// Voxels of `field`'s plane (about `per_row` per row and column of the voxels of `box`) whose
+/// sign is not the exact one; voxels on the curve are skipped, and with `band_only` those
+/// outside the exact field's band. `checked` is increased by the voxels compared.
+std::size_t voxel_sign_errors(const LayerField& field, const LayerField& exact, const Box2& box,
+                              double h, int per_row, bool band_only, std::size_t& checked) {
+    const int i0 = static_cast<int>(std::floor(box.min.x / h));
+    const int i1 = static_cast<int>(std::ceil(box.max.x / h));
+    const int j0 = static_cast<int>(std::floor(box.min.y / h));
+    const int j1 = static_cast<int>(std::ceil(box.max.y / h));
+    std::vector<int> signs;
+    std::vector<char> active;
+    detail::voxel_signs(field, i0, i1, j0, j1, signs, active);
+    const int stride = std::max(1, (i1 - i0) / per_row);
+    std::size_t errors = 0, k = 0;
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i, ++k) {
+            if ((i - i0) % stride != 0 || (j - j0) % stride != 0) continue;
+            const FieldSample es = exact.sample(Vec2(i * h, j * h));
+            if (std::abs(es.value) < 1e-9) continue;
+            if (band_only && !es.in_band) continue;
+            ++checked;
+            if (signs[k] != (es.value < 0.0 ? -1 : 1)) ++errors;
+        }
+    return errors;
+}
+
 /// Grid-vs-exact statistics over one layer.
 struct Agreement {
     std::size_t in_band = 0, smooth = 0, sign_errors = 0, corner_mismatch = 0, jumps = 0;
@@ -141,30 +167,11 @@ Agreement compare(const Layer& layer, int outside_sign, const ResolvedFieldParam
         }
     }
     // Every voxel of the box (band voxels and flood-filled ones) has the exact sign.
-    if (check_far_signs) {
-        const Box2 vb = box.inflated(4.0 * p.band_width);
-        const int i0 = static_cast<int>(std::floor(vb.min.x / h));
-        const int i1 = static_cast<int>(std::ceil(vb.max.x / h));
-        const int j0 = static_cast<int>(std::floor(vb.min.y / h));
-        const int j1 = static_cast<int>(std::ceil(vb.max.y / h));
-        std::vector<int> signs;
-        std::vector<char> active;
-        detail::voxel_signs(*grid, i0, i1, j0, j1, signs, active);
-        const int stride = std::max(1, (i1 - i0) / 300);
-        std::size_t k = 0;
-        for (int j = j0; j <= j1; ++j)
-            for (int i = i0; i <= i1; ++i, ++k) {
-                if ((i - i0) % stride != 0 || (j - j0) % stride != 0) continue;
-                const FieldSample es = exact->sample(Vec2(i * h, j * h));
-                const double v = es.value;
-                if (std::abs(v) < 1e-9) continue;
-                // Open layers out of the band: the region around an end connects both sides,
-                // so the flood fill's sign there is arbitrary (docs/field.md); band voxels only.
-                if (!layer.closed && !es.in_band) continue;
-                ++a.voxels_checked;
-                if (signs[k] != (v < 0.0 ? -1 : 1)) ++a.voxel_sign_errors;
-            }
-    }
+    // Open layers out of the band: the region around an end connects both sides, so the flood
+    // fill's sign there is arbitrary (docs/field.md); band voxels only.
+    if (check_far_signs)
+        a.voxel_sign_errors = voxel_sign_errors(*grid, *exact, box.inflated(4.0 * p.band_width), h,
+                                                300, !layer.closed, a.voxels_checked);
     return a;
 }
 
@@ -234,30 +241,6 @@ std::vector<Vec2> scene_queries(const Scene& scene, double band, std::size_t cou
         }
     }
     return out;
-}
-
-/// Voxels of `field`'s plane (every `stride`-th of the box around the scene) whose sign is not
-/// the exact one (closed layer; voxels on the curve skipped).
-std::size_t voxel_sign_errors(const LayerField& field, const LayerField& exact, const Box2& box,
-                              double h, std::size_t& checked) {
-    const int i0 = static_cast<int>(std::floor(box.min.x / h));
-    const int i1 = static_cast<int>(std::ceil(box.max.x / h));
-    const int j0 = static_cast<int>(std::floor(box.min.y / h));
-    const int j1 = static_cast<int>(std::ceil(box.max.y / h));
-    std::vector<int> signs;
-    std::vector<char> active;
-    detail::voxel_signs(field, i0, i1, j0, j1, signs, active);
-    const int stride = std::max(1, (i1 - i0) / 200);
-    std::size_t errors = 0, k = 0;
-    for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i, ++k) {
-            if ((i - i0) % stride != 0 || (j - j0) % stride != 0) continue;
-            const double v = exact.sample(Vec2(i * h, j * h)).value;
-            if (std::abs(v) < 1e-9) continue;
-            ++checked;
-            if (signs[k] != (v < 0.0 ? -1 : 1)) ++errors;
-        }
-    return errors;
 }
 
 }  // namespace
@@ -687,7 +670,8 @@ TEST_CASE("stacked grid: layers share leaves and keep their own planes", "[field
         const auto exact =
             make_field(scene.layer(i), 1, with_backend(p, FieldBackend::ExactIndexed));
         std::size_t checked = 0;
-        CHECK(voxel_sign_errors(fields.field(i), *exact, box, p.voxel_size, checked) == 0);
+        CHECK(voxel_sign_errors(fields.field(i), *exact, box, p.voxel_size, 200, false, checked) ==
+              0);
         CHECK(checked > 10000);
     }
 }
@@ -734,7 +718,8 @@ TEST_CASE("stacked grid: 9 layers span two leaf rows", "[field]") {
         const auto exact =
             make_field(scene.layer(i), 1, with_backend(p, FieldBackend::ExactIndexed));
         std::size_t checked = 0;
-        CHECK(voxel_sign_errors(fields.field(i), *exact, box, p.voxel_size, checked) == 0);
+        CHECK(voxel_sign_errors(fields.field(i), *exact, box, p.voxel_size, 200, false, checked) ==
+              0);
         const auto alone = make_field(scene.layer(i), 1, p);
         std::size_t differ = 0;
         for (const Vec2& x : qs)
