@@ -134,6 +134,7 @@ struct SceneFilter {
     std::vector<std::size_t> batches{0};  // each strata run at each; 0: SimplifyParams' default
     std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
     std::vector<std::size_t> give_up{1};  // give_up_when_stalled off (0) / on (1), each
+    std::vector<std::size_t> finish{1};   // finish_separations off (0) / on (1), each
     std::string decimator = "random";     // the paper's experiments
     bool closed = false;                  // wavy_loops instead of folded_stack
 };
@@ -151,12 +152,15 @@ void scenes(const SceneFilter& filter) {
     // per batch run (side by side); fields / untangle / check s: SimplifyReport's phase times,
     // summed over the untanglings (which run side by side: with threads, more than the wall).
     // give: UntangleParams::give_up_when_stalled; gave up: refused removals it ended early.
+    // fin: UntangleParams::finish_separations; finish s: its time; ok: the final exact check
+    // found no crossing and the nesting kept (SimplifyReport::collision_free).
     std::printf(
-        "%-6s %-7s %-5s %-8s %-9s %5s %3s %4s %8s %9s %7s %8s %8s %8s %8s %7s %7s %6s %5s %7s %9s "
-        "%9s %6s %8s %9s %8s\n",
-        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "give", "naive s", "strata s",
-        "ratio", "us/step", "loop us", "deferred", "refused", "gave up", "untangl", "jobs/b",
-        "cross", "gap/req", "H naive", "H strata", "rss MB", "fields s", "untangle s", "check s");
+        "%-6s %-7s %-5s %-8s %-9s %5s %3s %4s %3s %8s %9s %7s %8s %8s %8s %8s %7s %7s %6s %5s %3s "
+        "%7s %9s %9s %6s %8s %9s %8s %8s\n",
+        "layers", "pts", "rm", "backend", "schedule", "batch", "thr", "give", "fin", "naive s",
+        "strata s", "ratio", "us/step", "loop us", "deferred", "refused", "gave up", "untangl",
+        "jobs/b", "cross", "ok", "gap/req", "H naive", "H strata", "rss MB", "fields s",
+        "untangle s", "finish s", "check s");
     for (std::size_t count : {std::size_t(5), std::size_t(8)})
         for (std::size_t points = filter.min_points; points <= filter.max_points; points *= 10) {
             if (filter.layers != 0 && count != filter.layers) continue;
@@ -196,11 +200,15 @@ void scenes(const SceneFilter& filter) {
                         params.schedule = schedule;
                         params.untangling.field.backend = backend;
                         const std::size_t nt = filter.threads.size(), nb = filter.batches.size();
-                        for (std::size_t run = 0; run < filter.give_up.size() * nb * nt; ++run) {
-                            const std::size_t give = filter.give_up[run / (nb * nt)];
+                        const std::size_t ng = filter.give_up.size();
+                        for (std::size_t run = 0; run < filter.finish.size() * ng * nb * nt;
+                             ++run) {
+                            const std::size_t fin = filter.finish[run / (ng * nb * nt)];
+                            const std::size_t give = filter.give_up[(run / (nb * nt)) % ng];
                             const std::size_t batch = filter.batches[(run / nt) % nb];
                             const std::size_t threads = filter.threads[run % nt];
                             params.untangling.give_up_when_stalled = give != 0;
+                            params.untangling.finish_separations = fin != 0;
                             params.batch = batch > 0 ? batch : SimplifyParams{}.batch;
                             std::optional<tbb::global_control> limit;
                             if (threads > 0)
@@ -211,20 +219,21 @@ void scenes(const SceneFilter& filter) {
                             const SimplifyReport r = simplify(s, params);
                             const double ts = now() - t;
                             std::printf(
-                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %4zu %8.3f %9.3f %7.1f "
-                                "%8.2f %8.2f %8zu %8zu %7zu %7zu %6.2f %5zu %7.3f %9.4f %9.4f "
-                                "%6ld %8.3f %9.3f %8.3f\n",
+                                "%-6zu %-7zu %-5.2f %-8s %-9s %5zu %3zu %4zu %3zu %8.3f %9.3f "
+                                "%7.1f %8.2f %8.2f %8zu %8zu %7zu %7zu %6.2f %5zu %3s %7.3f "
+                                "%9.4f %9.4f %6ld %8.3f %9.3f %8.3f %8.3f\n",
                                 count, points, remove, name.c_str(), when.c_str(), params.batch,
-                                threads, give, tn, ts, ts / tn,
+                                threads, give, fin, tn, ts, ts / tn,
                                 1e6 * ts / static_cast<double>(r.removed),
                                 1e6 * r.seconds_total / static_cast<double>(r.removed), r.deferred,
                                 r.refused, r.gave_up, r.untangle_calls,
                                 r.batches ? static_cast<double>(r.untangle_calls) /
                                                 static_cast<double>(r.batches)
                                           : 0.0,
-                                r.crossings, r.min_separation_ratio, max_hausdorff(rn),
-                                max_hausdorff(r), peak_rss_mb(), r.seconds_fields,
-                                r.seconds_untangle, r.seconds_check);
+                                r.crossings, r.collision_free ? "yes" : "NO",
+                                r.min_separation_ratio, max_hausdorff(rn), max_hausdorff(r),
+                                peak_rss_mb(), r.seconds_fields, r.seconds_untangle,
+                                r.seconds_finish, r.seconds_check);
                             std::fflush(stdout);
                         }
                     }
@@ -284,6 +293,14 @@ int main(int argc, char** argv) {
                     return 2;
                 }
                 filter.give_up = numbers(value);
+            } else if (key == "--finish") {
+                if (value != "0" && value != "1" && value != "0,1" && value != "1,0") {
+                    std::fprintf(stderr,
+                                 "strata_bench_simplify: --finish must be 0, 1 or 0,1 (got %s)\n",
+                                 value.c_str());
+                    return 2;
+                }
+                filter.finish = numbers(value);
             } else if (key == "--schedule") {
                 filter.schedule = value;
             } else if (key == "--backend") {
@@ -305,7 +322,7 @@ int main(int argc, char** argv) {
             "usage: strata_bench_simplify paper | scenes [--min N] [--max N] "
             "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
             "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
-            "[--give-up 0,1] [--decimator random|visvalingam|max-error] [--shape open|closed]\n");
+            "[--give-up 0,1] [--finish 0,1] [--decimator random|visvalingam|max-error] [--shape open|closed]\n");
         return 2;
     }
     return 0;

@@ -34,6 +34,7 @@ struct SimplifyOptions {
     double thickness = 0.0;
     int threads = 0;
     bool no_shape_matching = false;
+    bool no_finish = false;
     bool naive = false;
     SimplifyParams params;
 };
@@ -72,6 +73,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                          {{"decimate", r.seconds_decimate},
                           {"fields", r.seconds_fields},
                           {"untangle", r.seconds_untangle},
+                          {"finish", r.seconds_finish},
                           {"check", r.seconds_check},
                           {"total", r.seconds_total}}}};
     if (naive)
@@ -313,12 +315,15 @@ Run add_simplify_command(CLI::App& app) {
                   "Untangle the whole scene after each tangling removal (slow; comparison)");
     cmd->add_flag("--no-untangle", opt->naive, "Naive decimation only");
     cmd->add_flag("--no-shape-matching", opt->no_shape_matching, "Pure projection");
+    cmd->add_flag("--no-finish", opt->no_finish,
+                  "Untangle without the finishing stage (exact separation constraints)");
     cmd->add_option("--svg", opt->svg, "Picture: input / naive / strata (one input)");
     cmd->add_option("--report", opt->report, "Report as JSON");
     return [opt, decimator]() {
         SimplifyOptions o = *opt;
         if (o.inputs.empty() && decimator->count() == 0) o.params.decimator = "random";
         if (o.no_shape_matching) o.params.untangling.shape = ShapeMode::None;
+        if (o.no_finish) o.params.untangling.finish_separations = false;
         validate(o.params);
         if (o.threads < 0)
             throw InvalidInput("simplify: --threads must be >= 0 (got " +

@@ -453,7 +453,21 @@ class Driver {
         return ok;
     }
 
-    // No vertex but a, b of any layer lies in the closed triangle (a, removed, b).
+    // Whether w (of layer k) lies strictly on the side of segment (pa, pb) of layer l that
+    // the nesting asks for: inside l when k is under l, outside when over (false for
+    // side-by-side layers, where the side of an open layer is not said).
+    bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
+                        const Vec2& w) const {
+        const Relation r = input_.relation(k, l);
+        if (r != Relation::Under && r != Relation::Over) return false;
+        const int outside = settings_.outside_signs[l];  // +1: outside on the right
+        const int wanted = r == Relation::Under ? outside : -outside;
+        return orient2d(pa, pb, w) == wanted;
+    }
+
+    // No vertex but a, b of any layer lies in the closed triangle (a, removed, b). With a
+    // job (after its untangling), a vertex of another layer on its own side of the chord
+    // (a, b) is allowed there.
     bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
                         const Overlay& ov) {
         const Vec2 pa = pos(l, a, ov), pb = pos(l, b, ov);
@@ -467,6 +481,9 @@ class Driver {
             for (std::size_t x : {u, layers_[k].next[u]}) {
                 if (k == l && (x == a || x == b)) continue;
                 if (point_in_closed_triangle(pa, removed, pb, pos(k, x, ov))) {
+                    // After an untangling the triangle is no longer swept: a vertex of
+                    // another layer may have moved into it from the side it belongs on.
+                    if (ov.job && k != l && on_wanted_side(k, l, pa, pb, pos(k, x, ov))) continue;
                     ok = false;
                     return;
                 }
@@ -875,6 +892,7 @@ class Driver {
         report_.seconds_check += job.seconds_prepare;
         report_.seconds_fields += job.result.seconds_fields;
         report_.seconds_untangle += job.result.seconds_untangle;
+        report_.seconds_finish += job.result.seconds_finish;
         report_.seconds_check += job.result.seconds_check;
         if (job.result.gave_up) ++report_.gave_up;
         if (!job.result.ok) return false;
@@ -1008,6 +1026,8 @@ class Driver {
             const Job& job = jobs[i];
             report_.seconds_fields += job.result.seconds_fields;  // the first run's time
             report_.seconds_untangle += job.result.seconds_untangle;
+            report_.seconds_finish += job.result.seconds_finish;
+        report_.seconds_finish += job.result.seconds_finish;
             report_.seconds_check += job.result.seconds_check + job.seconds_prepare;
             ++report_.batch_reruns;
             conclude(job.l, job.v, untangle_now(job.l, job.v));

@@ -47,6 +47,9 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         report.seconds_fields = r.seconds_fields;
         report.seconds_untangle = r.seconds_untangle;
         report.seconds_check = r.seconds_check;
+        report.seconds_finish = r.seconds_finish;
+        report.finishes = r.finishes;
+        report.finish_moves = r.finish_moves;
         report.crossings_after = check.crossing_count;
         report.min_separation_ratio_after = check.min_separation_ratio;
         for (std::size_t l = 0; l < scene.size(); ++l)

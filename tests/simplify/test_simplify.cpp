@@ -162,17 +162,20 @@ TEST_CASE("untanglings batched or one at a time give collision-free results", "[
     }
 }
 
-TEST_CASE("giving up on stalled untanglings saves passes and keeps the removals", "[simplify]") {
+TEST_CASE("giving up on stalled untanglings saves passes", "[simplify]") {
     // 8 layers at 95% with the paper's schedule: many untanglings, some of which fail. The
-    // stall rule (UntangleParams::give_up_when_stalled, on by default here) must end some of
-    // the failing ones early; on this scene it gives up on none that would have succeeded, so
-    // the outputs are identical (a measured property of this scene, not a guarantee).
+    // stall rule (UntangleParams::give_up_when_stalled, off by default since the finishing
+    // stage: it extrapolates the projection's violation, and the finishing stage ends many
+    // untanglings that the rule would give up on) must end some of the failing ones early,
+    // and the result stays valid either way.
     const Scene input = stack(8, 300, false, 0.0);
     SimplifyParams params;
     params.decimator = "random";
     params.remove = 0.95;
     params.schedule = UntangleSchedule::Immediate;
-    REQUIRE(params.untangling.give_up_when_stalled);
+    params.untangling.finish_separations = false;
+    REQUIRE_FALSE(params.untangling.give_up_when_stalled);
+    params.untangling.give_up_when_stalled = true;
     Scene early = input;
     const SimplifyReport on = simplify(early, params);
     require_valid(input, early, on, params.untangling.separation_tolerance);
@@ -184,10 +187,6 @@ TEST_CASE("giving up on stalled untanglings saves passes and keeps the removals"
     CHECK(on.gave_up > 0);
     CHECK(on.gave_up <= on.refused);
     CHECK(on.rounds < off.rounds);
-    CHECK(on.refused == off.refused);
-    CHECK(on.untangle_calls == off.untangle_calls);
-    for (std::size_t l = 0; l < input.size(); ++l)
-        CHECK(early.layer(l).points == full.layer(l).points);
 }
 
 TEST_CASE("global untangling (for comparison) gives collision-free results", "[simplify]") {

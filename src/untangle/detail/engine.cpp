@@ -1,5 +1,7 @@
 #include "untangle/detail/engine.h"
 
+#include "untangle/detail/separation.h"
+
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
 #include "strata/untangle/shape_matching.h"
@@ -529,9 +531,28 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     for (const Piece& piece : pieces)
         free_vertices +=
             static_cast<std::size_t>(std::count(piece.is_free.begin(), piece.is_free.end(), 1));
+    // UntangleParams::finish_separations: the finishing stage runs before the first check
+    // and before the check that ends every round (not after single projection steps).
+    SeparationParams finish;
+    finish.min_separation = settings.min_separation;
+    finish.outside_signs = &settings.outside_signs;
+    auto check = [&] {
+        const auto begin = Clock::now();
+        result.ok = is_ok(work);
+        result.seconds_check += seconds_since(begin);
+    };
+    auto finish_and_check = [&] {
+        if (params.finish_separations) {
+            const auto begin = Clock::now();
+            const SeparationResult f = finish_separations(work, pieces, relations, finish);
+            ++result.finishes;
+            result.finish_moves += f.moves;
+            result.seconds_finish += seconds_since(begin);
+        }
+        check();
+    };
+    finish_and_check();
     auto start = Clock::now();
-    result.ok = is_ok(work);
-    result.seconds_check += seconds_since(start);
     result.converged = result.ok;  // nothing to do is a converged run
     const int total_rounds = params.max_rounds * params.max_passes;
     std::vector<std::vector<Vec2>> rest = shapes_of(work, pieces);  // shape matching's rest
@@ -585,9 +606,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                 moved = engine.project(work, pieces);
                 if (settings.check_every_step && s + 1 < params.gradient_steps) {
                     result.seconds_untangle += seconds_since(start);
-                    start = Clock::now();
-                    result.ok = is_ok(work);
-                    result.seconds_check += seconds_since(start);
+                    check();
                     start = Clock::now();
                 }
                 if (params.give_up_when_stalled && round == 0 && s == 0 && !result.ok) {
@@ -610,18 +629,12 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
             }
             // The exact check after every round: a region that is already good stops here.
             result.seconds_untangle += seconds_since(start);
-            start = Clock::now();
-            result.ok = is_ok(work);
-            result.seconds_check += seconds_since(start);
+            finish_and_check();
             start = Clock::now();
             if (result.ok) break;
         }
         result.seconds_untangle += seconds_since(start);
-        if (!result.ok) {
-            start = Clock::now();
-            result.ok = is_ok(work);
-            result.seconds_check += seconds_since(start);
-        }
+        if (!result.ok) finish_and_check();
     }
     return result;
 }

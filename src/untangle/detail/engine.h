@@ -49,7 +49,10 @@ struct EngineResult {
     bool ok = false;         ///< is_ok(work) held at the end.
     double mean_speed = 0.0;
     bool gave_up = false;  ///< Stopped by UntangleParams::give_up_when_stalled.
+    int finishes = 0;              ///< Runs of the finishing stage (finish_separations()).
+    std::size_t finish_moves = 0;  ///< Vertex moves it made.
     double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
+    double seconds_finish = 0.0;
 };
 
 /// Resolves the automatic min_separation and sample_spacing from `scene` and the params.

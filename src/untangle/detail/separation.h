@@ -1,0 +1,53 @@
+#pragma once
+/// @file The untangling's finishing stage: exact separation constraints on the polylines.
+///
+/// The implicit projection decides which side of every other layer each vertex belongs to,
+/// but with its fields frozen within a pass it approaches the required gaps only slowly. This
+/// stage takes a work scene whose layers no longer cross near the free vertices and pushes
+/// apart every vertex and segment of two constrained layers that are closer than the gap
+/// aimed for, by projected Gauss-Seidel on point-segment distance constraints (Müller et al.
+/// 2007, position-based dynamics), weighted by the layer weights. A vertex is pushed only when
+/// it lies on the side of the other layer that the nesting asks for (the composition's side);
+/// one on the wrong side is left to the projection. Every move is validated exactly before it
+/// is made: the moved vertex's two new segments meet no other segment and sweep over no other
+/// vertex, so no layer tunnels through another and no crossing is ever created.
+
+#include "untangle/detail/engine.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace strata::detail {
+
+/// Settings of finish_separations().
+struct SeparationParams {
+    /// Gap aimed for between constrained layers a and b: max(required(a, b), min_separation),
+    /// scene units, >= 0.
+    double min_separation = 0.0;
+    int max_sweeps = 60;  ///< Gauss-Seidel sweeps over all constraints, at most. >= 1.
+    /// A sweep that leaves every pair within this fraction of its aim ends the stage.
+    double tolerance = 0.02;
+    /// Outside side of each work layer (+1: on the right of its direction of travel), see
+    /// outside_side(); it says on which side of another layer a vertex belongs.
+    const std::vector<int>* outside_signs = nullptr;
+};
+
+/// What finish_separations() did.
+struct SeparationResult {
+    int sweeps = 0;
+    std::size_t moves = 0;       ///< Vertex moves made (each validated).
+    std::size_t refused = 0;     ///< Moves refused because they would have tunnelled.
+    std::size_t wrong_side = 0;  ///< Close vertices on the wrong side at the last sweep.
+    double worst = 0.0;  ///< Largest remaining shortfall, as a fraction of the aim (0: none).
+    /// The sweeps left the worst pair worse (or more vertices on the wrong side) than they
+    /// found it, so every move was undone.
+    bool reverted = false;
+};
+
+/// Pushes the layers of `work` apart where they are closer than aimed for. Only the free
+/// vertices of `pieces` move. Deterministic (sequential, in layer and vertex order).
+SeparationResult finish_separations(Scene& work, const std::vector<Piece>& pieces,
+                                    const RelationSource& relations,
+                                    const SeparationParams& params);
+
+}  // namespace strata::detail
