@@ -532,7 +532,8 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         free_vertices +=
             static_cast<std::size_t>(std::count(piece.is_free.begin(), piece.is_free.end(), 1));
     // UntangleParams::finish_separations: the finishing stage runs before the first check
-    // and before the check that ends every round (not after single projection steps).
+    // and before the check that ends every round; before the checks after single projection
+    // steps (check_every_step) only once the projection has taken the tangles out.
     SeparationParams finish;
     finish.min_separation = settings.min_separation;
     finish.outside_signs = &settings.outside_signs;
@@ -541,9 +542,10 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         result.ok = is_ok(work);
         result.seconds_check += seconds_since(begin);
     };
-    auto finish_and_check = [&] {
+    auto finish_and_check = [&](bool only_when_untangled) {
         if (params.finish_separations) {
             const auto begin = Clock::now();
+            finish.only_when_untangled = only_when_untangled;
             const SeparationResult f = finish_separations(work, pieces, relations, finish);
             ++result.finishes;
             result.finish_moves += f.moves;
@@ -551,7 +553,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         }
         check();
     };
-    finish_and_check();
+    finish_and_check(false);
     auto start = Clock::now();
     result.converged = result.ok;  // nothing to do is a converged run
     const int total_rounds = params.max_rounds * params.max_passes;
@@ -606,7 +608,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                 moved = engine.project(work, pieces);
                 if (settings.check_every_step && s + 1 < params.gradient_steps) {
                     result.seconds_untangle += seconds_since(start);
-                    check();
+                    finish_and_check(true);
                     start = Clock::now();
                 }
                 if (params.give_up_when_stalled && round == 0 && s == 0 && !result.ok) {
@@ -629,12 +631,12 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
             }
             // The exact check after every round: a region that is already good stops here.
             result.seconds_untangle += seconds_since(start);
-            finish_and_check();
+            finish_and_check(false);
             start = Clock::now();
             if (result.ok) break;
         }
         result.seconds_untangle += seconds_since(start);
-        if (!result.ok) finish_and_check();
+        if (!result.ok) finish_and_check(false);
     }
     return result;
 }

@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
-#include <unordered_map>
 
 namespace strata::detail {
 
@@ -20,7 +19,10 @@ struct SegId {
     std::uint32_t layer, index;
 };
 
-// The segments of the work scene in a uniform hash grid, kept up to date as vertices move.
+// The segments of the work scene in a uniform grid over its bounds (compressed rows: one
+// array of segment ids, cell by cell), built at the positions of one moment. Vertices that
+// move afterwards are accounted for by growing every query by the largest move since the
+// build; past half a cell the grid is built again.
 class SegmentCells {
   public:
     SegmentCells(const std::vector<std::vector<Vec2>>& pts, const std::vector<char>& closed,
@@ -29,10 +31,8 @@ class SegmentCells {
         offset_.assign(1, 0);
         for (std::size_t l = 0; l < pts.size(); ++l)
             offset_.push_back(offset_.back() + segment_count(l));
-        range_.resize(offset_.back());
         stamp_.assign(offset_.back(), 0);
-        for (std::size_t l = 0; l < pts.size(); ++l)
-            for (std::size_t k = 0; k < segment_count(l); ++k) insert(l, k);
+        build();
     }
 
     std::size_t segment_count(std::size_t l) const {
@@ -40,71 +40,91 @@ class SegmentCells {
         return n < 2 ? 0 : closed_[l] ? n : n - 1;
     }
     Vec2 start(const SegId& s) const { return pts_[s.layer][s.index]; }
-    Vec2 end(const SegId& s) const { return pts_[s.layer][(s.index + 1) % pts_[s.layer].size()]; }
-
-    // Re-files segment k of layer l after one of its ends moved.
-    void refile(std::size_t l, std::size_t k) {
-        const Range& r = range_[offset_[l] + k];
-        for (long long ix = r.x0; ix <= r.x1; ++ix)
-            for (long long iy = r.y0; iy <= r.y1; ++iy) {
-                std::vector<SegId>& cell = cells_[pack(ix, iy)];
-                for (std::size_t i = 0; i < cell.size(); ++i)
-                    if (cell[i].layer == l && cell[i].index == k) {
-                        cell[i] = cell.back();
-                        cell.pop_back();
-                        break;
-                    }
-            }
-        insert(l, k);
+    Vec2 end(const SegId& s) const {
+        return pts_[s.layer][(s.index + 1) % pts_[s.layer].size()];
     }
 
-    // Calls f(SegId) once for every segment filed in a cell that `box` touches.
+    // Vertex (l, v) has moved (pts was updated).
+    void moved(std::size_t l, std::size_t v) {
+        drift_ = std::max(drift_, glm::distance(pts_[l][v], built_[l][v]));
+        if (drift_ > 0.5 * cell_) build();
+    }
+
+    // Calls f(SegId) once for every segment that may meet `box`.
     template <class F>
     void query(const Box2& box, F&& f) {
         ++tick_;
-        const long long x0 = coord(box.min.x), x1 = coord(box.max.x);
-        const long long y0 = coord(box.min.y), y1 = coord(box.max.y);
-        for (long long ix = x0; ix <= x1; ++ix)
-            for (long long iy = y0; iy <= y1; ++iy) {
-                auto it = cells_.find(pack(ix, iy));
-                if (it == cells_.end()) continue;
-                for (const SegId& s : it->second) {
-                    std::uint32_t& seen = stamp_[offset_[s.layer] + s.index];
+        const Box2 b = box.inflated(drift_);
+        const std::size_t x0 = column(b.min.x), x1 = column(b.max.x);
+        const std::size_t y0 = row(b.min.y), y1 = row(b.max.y);
+        for (std::size_t iy = y0; iy <= y1; ++iy)
+            for (std::size_t ix = x0; ix <= x1; ++ix) {
+                const std::size_t c = iy * nx_ + ix;
+                for (std::uint32_t k = start_[c]; k < start_[c + 1]; ++k) {
+                    const SegId& seg = ids_[k];
+                    std::uint32_t& seen = stamp_[offset_[seg.layer] + seg.index];
                     if (seen == tick_) continue;
                     seen = tick_;
-                    f(s);
+                    f(seg);
                 }
             }
     }
 
   private:
-    struct Range {
-        long long x0 = 0, x1 = -1, y0 = 0, y1 = -1;
-    };
-
-    void insert(std::size_t l, std::size_t k) {
-        const SegId s{static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)};
-        const Vec2 a = start(s), b = end(s);
-        Range& r = range_[offset_[l] + k];
-        r = {coord(std::min(a.x, b.x)), coord(std::max(a.x, b.x)), coord(std::min(a.y, b.y)),
-             coord(std::max(a.y, b.y))};
-        for (long long ix = r.x0; ix <= r.x1; ++ix)
-            for (long long iy = r.y0; iy <= r.y1; ++iy) cells_[pack(ix, iy)].push_back(s);
+    void build() {
+        built_ = pts_;
+        drift_ = 0.0;
+        origin_ = Box2{};
+        for (const std::vector<Vec2>& layer : pts_)
+            for (const Vec2& p : layer) origin_.extend(p);
+        const std::size_t segments = offset_.back();
+        // At most about 4 cells per segment: a larger cell where the bounds are wide.
+        const Vec2 size = origin_.size();
+        double cell = cell_;
+        const double budget = 4.0 * static_cast<double>(std::max<std::size_t>(segments, 1));
+        while ((size.x / cell + 1.0) * (size.y / cell + 1.0) > budget) cell *= 2.0;
+        step_ = cell;
+        nx_ = static_cast<std::size_t>(size.x / cell) + 1;
+        ny_ = static_cast<std::size_t>(size.y / cell) + 1;
+        start_.assign(nx_ * ny_ + 1, 0);
+        auto each_cell = [&](std::size_t l, std::size_t k, auto&& g) {
+            const SegId s{static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)};
+            const Vec2 a = start(s), b = end(s);
+            for (std::size_t iy = row(std::min(a.y, b.y)); iy <= row(std::max(a.y, b.y)); ++iy)
+                for (std::size_t ix = column(std::min(a.x, b.x));
+                     ix <= column(std::max(a.x, b.x)); ++ix)
+                    g(iy * nx_ + ix, s);
+        };
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t k = 0; k < segment_count(l); ++k)
+                each_cell(l, k, [&](std::size_t c, const SegId&) { ++start_[c + 1]; });
+        for (std::size_t c = 0; c < nx_ * ny_; ++c) start_[c + 1] += start_[c];
+        ids_.resize(start_.back());
+        fill_ = start_;
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t k = 0; k < segment_count(l); ++k)
+                each_cell(l, k, [&](std::size_t c, const SegId& s) { ids_[fill_[c]++] = s; });
     }
-    long long coord(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
-    static std::uint64_t pack(long long ix, long long iy) {
-        return (static_cast<std::uint64_t>(ix) << 32) ^
-               (static_cast<std::uint64_t>(iy) & 0xffffffffULL);
+    std::size_t column(double x) const { return clamp_index((x - origin_.min.x) / step_, nx_); }
+    std::size_t row(double y) const { return clamp_index((y - origin_.min.y) / step_, ny_); }
+    static std::size_t clamp_index(double v, std::size_t n) {
+        if (!(v > 0.0)) return 0;  // NaN too
+        return std::min(static_cast<std::size_t>(v), n - 1);
     }
 
     const std::vector<std::vector<Vec2>>& pts_;
     const std::vector<char>& closed_;
-    double cell_;
-    std::vector<std::size_t> offset_;
-    std::vector<Range> range_;
+    double cell_;         // the cell size asked for
+    double step_ = 1.0;   // the cell size built
+    Box2 origin_;         // the bounds at the build
+    std::size_t nx_ = 1, ny_ = 1;
+    std::vector<std::uint32_t> start_, fill_;  // per cell, into ids_
+    std::vector<SegId> ids_;
+    std::vector<std::size_t> offset_;  // first global id of each layer's segments
     std::vector<std::uint32_t> stamp_;
     std::uint32_t tick_ = 0;
-    std::unordered_map<std::uint64_t, std::vector<SegId>> cells_;
+    std::vector<std::vector<Vec2>> built_;  // the positions at the build
+    double drift_ = 0.0;                    // largest move since the build
 };
 
 bool in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
@@ -159,6 +179,7 @@ class Finisher {
         // take out first (the check fails on it anyway): look before moving anything.
         measure(result, changed);
         if (wrong_side_ == 0 && worst_ <= params_.tolerance) return result;
+        if (wrong_side_ > 0 && params_.only_when_untangled) return result;
         const std::size_t wrong_before = wrong_side_;
         const double worst_before = worst_;
         const std::vector<std::vector<Vec2>> before = pts_;
@@ -290,9 +311,7 @@ class Finisher {
             if (to == p) return;
             if (!is_safe(l, v, p, to)) continue;
             pts_[l][v] = to;
-            const std::size_t n = layer_size(l);
-            if (closed_[l] || v > 0) cells_->refile(l, (v + n - 1) % n);
-            if (closed_[l] || v + 1 < n) cells_->refile(l, v);
+            cells_->moved(l, v);
             changed[l] = true;
             ++result.moves;
             return;

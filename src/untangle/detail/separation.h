@@ -27,6 +27,9 @@ struct SeparationParams {
     int max_sweeps = 60;  ///< Gauss-Seidel sweeps over all constraints, at most. >= 1.
     /// A sweep that leaves every pair within this fraction of its aim ends the stage.
     double tolerance = 0.02;
+    /// Leave the scene as it is when a close vertex lies on the wrong side of another layer
+    /// (a tangle the projection has yet to take out): the run then costs one measuring sweep.
+    bool only_when_untangled = false;
     /// Outside side of each work layer (+1: on the right of its direction of travel), see
     /// outside_side(); it says on which side of another layer a vertex belongs.
     const std::vector<int>* outside_signs = nullptr;
