@@ -125,7 +125,11 @@ Run add_untangle_command(CLI::App& app) {
         std::printf(
             "passes: %d, rounds: %d, %s; time %.3f s (fields %.3f, untangle %.3f, finish %.3f, "
             "check %.3f)\n",
-            r.passes, r.rounds, r.converged ? "converged" : "NOT converged (round cap)", seconds,
+            r.passes, r.rounds,
+            r.collision_free ? "collision-free"
+            : r.converged    ? "converged, NOT collision-free"
+                             : "NOT collision-free at the pass cap",
+            seconds,
             r.seconds_fields, r.seconds_untangle, r.seconds_finish, r.seconds_check);
         if (!r.collision_free)
             std::fprintf(

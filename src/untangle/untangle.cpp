@@ -27,7 +27,9 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         CheckParams check_params;
         check_params.separation_tolerance = params.separation_tolerance;
         // Orientation of open layers from the input, where the nesting is the intended one.
-        const detail::EngineSettings settings = detail::resolve_settings(scene, params);
+        detail::EngineSettings settings = detail::resolve_settings(scene, params);
+        // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
+        settings.rest_at_start = true;
         CheckReport check = check_scene(scene, check_params);
         report.crossings_before = check.crossing_count;
         auto is_ok = [&](const Scene& s) {

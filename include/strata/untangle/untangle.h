@@ -23,7 +23,7 @@ enum class ShapeMode {
 
 /// Parameters of untangle() and Untangler. Lengths are in scene units.
 struct UntangleParams {
-    int gradient_steps = 30;  ///< N_gd: projection steps per round (then one shape matching). >= 1.
+    int gradient_steps = 10;  ///< N_gd: projection steps per round (then one shape matching). >= 1.
     double step = 0.5;        ///< dt: damping of each normalised projection step, (0, 1].
     /// Each vertex step is clamped to this fraction of the shorter adjacent edge. (0, 1].
     double max_step_fraction = 0.25;
@@ -43,10 +43,14 @@ struct UntangleParams {
     /// epsilon: a pass has converged when the mean displacement of the free vertices in the last
     /// projection step of a round (V, Eq. 7) is <= tolerance * scene diagonal. > 0.
     double tolerance = 1e-6;
-    int max_rounds = 60;  ///< Cap on rounds per pass. >= 1.
-    /// Passes: when a pass ends with the region still tangled, the fields are rebuilt from the
-    /// current geometry and the untangling runs again. >= 1.
-    int max_passes = 8;
+    int max_rounds = 1;  ///< Cap on rounds per pass. >= 1.
+    /// Passes: when a pass ends with the region still tangled, the fields are brought up to
+    /// date with the current geometry and the untangling runs again. >= 1.
+    /// The defaults (64 passes of one round of 10 steps; shape matching toward the input
+    /// before every round but the first) refresh the fields often: with the finishing stage,
+    /// 12 concentric loops x 15 vertices (172 crossings) untangle in 1.3 s on one core
+    /// against 26 s with 8 passes of 60 rounds of 30 steps (docs/untangle.md).
+    int max_passes = 64;
     /// Smallest separation the untangling aims for between any two constrained layers, scene
     /// units, >= 0, used where the thicknesses ask for less: layers of zero thickness would
     /// otherwise be projected onto each other and touch. 0 = automatic: 1% of the median
