@@ -25,9 +25,10 @@ struct SegId {
 // build; past half a cell the grid is built again.
 class SegmentCells {
   public:
+    // Files the segments whose box meets `region` (queries must stay inside it).
     SegmentCells(const std::vector<std::vector<Vec2>>& pts, const std::vector<char>& closed,
-                 double cell)
-        : pts_(pts), closed_(closed), cell_(cell) {
+                 double cell, const Box2& region)
+        : pts_(pts), closed_(closed), cell_(cell), region_(region) {
         offset_.assign(1, 0);
         for (std::size_t l = 0; l < pts.size(); ++l)
             offset_.push_back(offset_.back() + segment_count(l));
@@ -74,10 +75,10 @@ class SegmentCells {
     void build() {
         built_ = pts_;
         drift_ = 0.0;
-        origin_ = Box2{};
-        for (const std::vector<Vec2>& layer : pts_)
-            for (const Vec2& p : layer) origin_.extend(p);
-        const std::size_t segments = offset_.back();
+        origin_ = region_;
+        std::size_t segments = 0;
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t k = 0; k < segment_count(l); ++k) segments += is_filed(l, k);
         // At most about 4 cells per segment: a larger cell where the bounds are wide.
         const Vec2 size = origin_.size();
         double cell = cell_;
@@ -97,13 +98,22 @@ class SegmentCells {
         };
         for (std::size_t l = 0; l < pts_.size(); ++l)
             for (std::size_t k = 0; k < segment_count(l); ++k)
-                each_cell(l, k, [&](std::size_t c, const SegId&) { ++start_[c + 1]; });
+                if (is_filed(l, k))
+                    each_cell(l, k, [&](std::size_t c, const SegId&) { ++start_[c + 1]; });
         for (std::size_t c = 0; c < nx_ * ny_; ++c) start_[c + 1] += start_[c];
         ids_.resize(start_.back());
         fill_ = start_;
         for (std::size_t l = 0; l < pts_.size(); ++l)
             for (std::size_t k = 0; k < segment_count(l); ++k)
-                each_cell(l, k, [&](std::size_t c, const SegId& s) { ids_[fill_[c]++] = s; });
+                if (is_filed(l, k))
+                    each_cell(l, k, [&](std::size_t c, const SegId& s) { ids_[fill_[c]++] = s; });
+    }
+    bool is_filed(std::size_t l, std::size_t k) const {
+        const SegId s{static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)};
+        Box2 box;
+        box.extend(start(s));
+        box.extend(end(s));
+        return box.inflated(drift_ + cell_).overlaps(region_);
     }
     std::size_t column(double x) const { return clamp_index((x - origin_.min.x) / step_, nx_); }
     std::size_t row(double y) const { return clamp_index((y - origin_.min.y) / step_, ny_); }
@@ -115,6 +125,7 @@ class SegmentCells {
     const std::vector<std::vector<Vec2>>& pts_;
     const std::vector<char>& closed_;
     double cell_;         // the cell size asked for
+    Box2 region_;         // where queries are made
     double step_ = 1.0;   // the cell size built
     Box2 origin_;         // the bounds at the build
     std::size_t nx_ = 1, ny_ = 1;
@@ -173,7 +184,24 @@ class Finisher {
             std::nth_element(lengths.begin(), mid, lengths.end());
             cell = std::max(cell, *mid);
         }
-        cells_.emplace(pts_, closed_, cell);
+        // Only what lies near the free vertices (and their neighbours) can be relaxed.
+        Box2 region;
+        for (std::size_t l = 0; l < pts_.size(); ++l) {
+            const std::size_t n = pts_[l].size();
+            for (std::size_t v = 0; v < n; ++v) {
+                if (inverse_mass_[l][v] == 0.0) continue;
+                region.extend(pts_[l][v]);
+                if (closed_[l] || v > 0) region.extend(pts_[l][(v + n - 1) % n]);
+                if (closed_[l] || v + 1 < n) region.extend(pts_[l][(v + 1) % n]);
+            }
+        }
+        if (region.is_empty()) return result;
+        region = region.inflated(2.0 * reach_);
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t v = 0; v < pts_[l].size(); ++v)
+                if (region.contains(pts_[l][v]))
+                    active_.push_back({static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(v)});
+        cells_.emplace(pts_, closed_, cell, region);
         std::vector<bool> changed(pts_.size(), false);
         // A close vertex on the wrong side of another layer is a tangle the projection has to
         // take out first (the check fails on it anyway): look before moving anything.
@@ -189,9 +217,7 @@ class Finisher {
             ++result.sweeps;
             worst_ = 0.0;
             wrong_side_ = 0;
-            for (std::size_t l = 0; l < pts_.size(); ++l)
-                for (std::size_t v = 0; v < pts_[l].size(); ++v)
-                    relax_vertex(l, v, result, changed, true);
+            for (const SegId& a : active_) relax_vertex(a.layer, a.index, result, changed, true);
             result.worst = worst_;
             result.wrong_side = wrong_side_;
             if (worst_ <= params_.tolerance) break;
@@ -223,9 +249,7 @@ class Finisher {
     void measure(SeparationResult& result, std::vector<bool>& changed) {
         worst_ = 0.0;
         wrong_side_ = 0;
-        for (std::size_t l = 0; l < pts_.size(); ++l)
-            for (std::size_t v = 0; v < pts_[l].size(); ++v)
-                relax_vertex(l, v, result, changed, false);
+        for (const SegId& a : active_) relax_vertex(a.layer, a.index, result, changed, false);
         result.worst = worst_;
         result.wrong_side = wrong_side_;
     }
@@ -370,6 +394,7 @@ class Finisher {
     std::vector<Relation> relation_;
     double reach_ = 0.0;  // largest aim
     std::optional<SegmentCells> cells_;
+    std::vector<SegId> active_;  // (layer, vertex) of the vertices near the free ones
     std::vector<SegId> found_;
     double worst_ = 0.0;
     std::size_t wrong_side_ = 0;
