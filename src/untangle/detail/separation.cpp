@@ -183,7 +183,10 @@ class Finisher {
             auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
             std::nth_element(lengths.begin(), mid, lengths.end());
             cell = std::max(cell, *mid);
+            tangle_reach_ = std::max(reach_, *mid);
         }
+        tangle_reach_ = std::max(tangle_reach_, reach_);
+        cell = std::max(cell, tangle_reach_);
         // Only what lies near the free vertices (and their neighbours) can be relaxed.
         Box2 region;
         for (std::size_t l = 0; l < pts_.size(); ++l) {
@@ -196,7 +199,7 @@ class Finisher {
             }
         }
         if (region.is_empty()) return result;
-        region = region.inflated(2.0 * reach_);
+        region = region.inflated(2.0 * tangle_reach_);
         for (std::size_t l = 0; l < pts_.size(); ++l)
             for (std::size_t v = 0; v < pts_[l].size(); ++v)
                 if (region.contains(pts_[l][v]))
@@ -256,18 +259,45 @@ class Finisher {
 
     // Every segment of another constrained layer closer to vertex (l, v) than aimed for is
     // pushed away from it, the vertex the other way, in proportion to the inverse masses.
-    // apply = false: only measures (worst_, wrong_side_).
+    // When the vertex lies on the wrong side of its nearest segment of another layer (judged
+    // within tangle_reach_, which is larger than the aims), it is pushed over to its side
+    // instead, and that layer's other segments wait. apply = false: only measures (worst_,
+    // wrong_side_).
     void relax_vertex(std::size_t l, std::size_t v, SeparationResult& result,
                       std::vector<bool>& changed, bool apply) {
         const std::size_t n = pts_.size();
         Box2 box;
         box.extend(pts_[l][v]);
         found_.clear();
-        cells_->query(box.inflated(reach_), [&](const SegId& s) {
+        cells_->query(box.inflated(tangle_reach_), [&](const SegId& s) {
             if (s.layer != l && relation_[l * n + s.layer] != Relation::Same) found_.push_back(s);
         });
-        for (const SegId& s : found_) {
+        if (found_.empty()) return;
+        // The nearest segment of each layer, and whether the vertex is on its wrong side.
+        nearest_.clear();
+        for (std::size_t i = 0; i < found_.size(); ++i) {
+            const SegId& s = found_[i];
+            const double d = point_segment_distance(pts_[l][v], cells_->start(s), cells_->end(s));
+            auto it = std::find_if(nearest_.begin(), nearest_.end(),
+                                   [&](const Nearest& x) { return x.layer == s.layer; });
+            if (it == nearest_.end())
+                nearest_.push_back({s.layer, i, d, false});
+            else if (d < it->distance)
+                *it = {s.layer, i, d, false};
+        }
+        for (Nearest& x : nearest_) {
+            const SegId& s = found_[x.index];
+            const Vec2 q0 = cells_->start(s), q1 = cells_->end(s), p = pts_[l][v];
+            const int wanted = wanted_side(l, s.layer);
+            x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
+                         orient2d(q0, q1, p) != wanted;
+        }
+        for (std::size_t i = 0; i < found_.size(); ++i) {
+            const SegId& s = found_[i];
             const std::size_t m = s.layer;
+            const Nearest& near = *std::find_if(nearest_.begin(), nearest_.end(),
+                                                [&](const Nearest& x) { return x.layer == m; });
+            if (near.is_wrong && near.index != i) continue;  // the tangle first
             const double aim = aim_[l * n + m];
             const std::size_t k0 = s.index, k1 = (s.index + 1) % layer_size(m);
             const Vec2 p = pts_[l][v], q0 = pts_[m][k0], q1 = pts_[m][k1];
@@ -276,29 +306,22 @@ class Finisher {
             if (wp == 0.0 && w0 == 0.0 && w1 == 0.0) continue;
             Vec2 c;
             const double d = point_segment_distance(p, q0, q1, &c);
-            if (!(d < aim)) continue;
             const Vec2 e = q1 - q0;
             const double e2 = glm::dot(e, e);
             const double t = e2 > 0.0 ? std::clamp(glm::dot(p - q0, e) / e2, 0.0, 1.0) : 0.0;
-            // The side p must be on; at an end of the segment, the side it is on.
             Vec2 normal;
             double shortfall = aim - d;
-            if (t > 0.0 && t < 1.0) {
+            if (near.is_wrong) {  // over to the side it belongs on, at the aim
                 const Vec2 left(-e.y, e.x);  // orient2d(q0, q1, q0 + left) = +1
-                const int wanted = wanted_side(l, m);
-                const int side = orient2d(q0, q1, p);
-                normal = (wanted != 0 ? static_cast<double>(wanted)
-                          : side != 0 ? side
-                                      : 1.0) *
-                         left / std::sqrt(e2);
-                if (wanted != 0 && side != wanted) {  // crossed: over to the other side
-                    ++wrong_side_;
-                    shortfall = aim + d;
-                }
+                normal = static_cast<double>(wanted_side(l, m)) * left / std::sqrt(e2);
+                shortfall = aim + d;
+                ++wrong_side_;
+            } else if (!(d < aim)) {
+                continue;
             } else if (d > 1e-12 * aim) {
                 normal = (p - c) / d;
             } else {
-                ++wrong_side_;  // on an end of the segment: a contact, left to the projection
+                ++wrong_side_;  // on the other layer: a contact, left to the projection
                 continue;
             }
             worst_ = std::max(worst_, shortfall / aim);
@@ -311,6 +334,13 @@ class Finisher {
                 try_move(m, k0, -w0 * (1.0 - t) * lambda * normal, result, changed);
             if (w1 > 0.0 && t > 0.0) try_move(m, k1, -w1 * t * lambda * normal, result, changed);
         }
+    }
+
+    // The foot of p on segment (q0, q1) lies strictly inside it.
+    static bool interior(const Vec2& p, const Vec2& q0, const Vec2& q1) {
+        const Vec2 e = q1 - q0;
+        const double along = glm::dot(p - q0, e);
+        return along > 0.0 && along < glm::dot(e, e);
     }
 
     // The side of layer m's segments (orient2d sign) that layer l's vertices must be on, by
@@ -343,10 +373,11 @@ class Finisher {
         ++result.refused;
     }
 
-    // Exact: moving vertex (l, v) from p to `to` keeps every other segment and vertex where it
-    // was relative to layer l. The new segments (prev, to) and (to, next) must meet no segment
-    // they do not share an end with, and the triangles swept by the old ones must hold no
-    // other vertex; then no segment can have passed through the moving ones.
+    // Exact: moving vertex (l, v) from p to `to` tunnels through nothing. The new segments
+    // (prev, to) and (to, next) may meet only segments that the old ones met (a vertex on the
+    // wrong side of a layer moves back over it one vertex at a time), and the triangles swept
+    // by the old segments must hold no other vertex; then no segment that the old ones did
+    // not meet can have passed through the moving ones, and no new contact is made.
     bool is_safe(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) {
         const std::size_t n = layer_size(l);
         const bool has_prev = closed_[l] || v > 0, has_next = closed_[l] || v + 1 < n;
@@ -365,15 +396,21 @@ class Finisher {
         auto is_mover = [&](std::size_t m, std::size_t k) {
             return m == l && (k == v || (has_prev && k == prev) || (has_next && k == next));
         };
+        auto meets = [](const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
+            return segment_contact(a0, a1, b0, b1) != SegmentContact::None;
+        };
         cells_->query(box, [&](const SegId& s) {
             if (!safe) return;
             const Vec2 a = cells_->start(s), b = cells_->end(s);
-            if (has_prev && !shares_end(s, prev, v) &&
-                segment_contact(pts_[l][prev], to, a, b) != SegmentContact::None)
-                safe = false;
-            if (has_next && !shares_end(s, v, next) &&
-                segment_contact(to, pts_[l][next], a, b) != SegmentContact::None)
-                safe = false;
+            const bool with_prev = has_prev && !shares_end(s, prev, v);
+            const bool with_next = has_next && !shares_end(s, v, next);
+            if ((with_prev && meets(pts_[l][prev], to, a, b)) ||
+                (with_next && meets(to, pts_[l][next], a, b))) {
+                // Allowed only where the old segments met it too.
+                if (!((with_prev && meets(pts_[l][prev], p, a, b)) ||
+                      (with_next && meets(p, pts_[l][next], a, b))))
+                    safe = false;
+            }
             const std::size_t ends[2] = {s.index, (s.index + 1) % layer_size(s.layer)};
             for (std::size_t e = 0; e < 2 && safe; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
@@ -393,6 +430,15 @@ class Finisher {
     std::vector<double> aim_;  // n x n, 0 where unconstrained
     std::vector<Relation> relation_;
     double reach_ = 0.0;  // largest aim
+    // How far from another layer a vertex on its wrong side is seen: max(reach_, the median
+    // segment length of the work scene).
+    double tangle_reach_ = 0.0;
+    struct Nearest {
+        std::size_t layer, index;  // index into found_
+        double distance;
+        bool is_wrong;
+    };
+    std::vector<Nearest> nearest_;
     std::optional<SegmentCells> cells_;
     std::vector<SegId> active_;  // (layer, vertex) of the vertices near the free ones
     std::vector<SegId> found_;
