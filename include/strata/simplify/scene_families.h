@@ -1,0 +1,47 @@
+#pragma once
+/// @file Generated multi-layered scenes, one function per family of the untangling benchmark
+/// (bench/bench_untangle.cpp, docs/untangle.md) and its tests: untangled, valid inputs with
+/// known geometry, to be tangled by a decimation. Deterministic; lengths in scene units.
+
+#include "strata/core/types.h"
+#include "strata/geometry/scene.h"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace strata {
+
+/// The families.
+enum class SceneFamily {
+    Stack,   ///< `layers` open layers offset along the normal of a wavy curve (one stack).
+    Loops,   ///< `layers` concentric wavy closed loops (one stack, each inside the next).
+    Folded,  ///< A stack of `layers` open layers folded twice (an S): its outer layers face
+             ///< each other across the first fold, its inner ones across the second.
+    Rolled,  ///< Two open layers; the inner one comes around the end of the outer one and lies
+             ///< on top of it (the paper's Fig. 7b,c): the global order does not hold there.
+    Jacket,  ///< A closed body loop under an open jacket arc that covers 3/4 of it.
+    Legs,    ///< Two closed leg loops side by side inside a closed skirt loop (`outer` links).
+};
+
+/// All families, in the order above.
+std::vector<SceneFamily> all_scene_families();
+/// "stack", "loops", "folded", "rolled", "jacket", "legs".
+std::string family_name(SceneFamily family);
+
+/// Size and spacing of a generated scene.
+struct FamilyParams {
+    std::size_t layers = 6;    ///< Layers (Stack, Loops, Folded); the others have fixed counts.
+    std::size_t points = 300;  ///< Vertices per layer (about; closed loops exactly).
+    /// Gap between neighbouring layers in segment lengths (> 0); every layer's thickness is
+    /// half the gap, so the required separation is half the gap.
+    double gap = 2.0;
+    double scale = 1.0;  ///< Every coordinate multiplied by this (> 0) ...
+    Vec2 offset{0.0};    ///< ... then shifted by this.
+};
+
+/// The scene of `family`. @throws InvalidInput on bad params (zero points or layers, gap or
+/// scale not > 0).
+Scene make_scene(SceneFamily family, const FamilyParams& params = {});
+
+}  // namespace strata

@@ -1,0 +1,257 @@
+#include "strata/simplify/scene_families.h"
+
+#include "strata/core/error.h"
+#include "strata/core/format.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace strata {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Layer make_layer(std::string name, double thickness, bool closed = false) {
+    Layer layer;
+    layer.name = std::move(name);
+    layer.thickness = thickness;
+    layer.closed = closed;
+    return layer;
+}
+
+// Stack: offsets along the normal of y = A (0.5 sin 0.6x + 0.18 sin(2.3x + 0.5)) over
+// [0, 10], A chosen so that the outermost offset stays within half the smallest radius of
+// curvature (0.88 / A): no layer loops over itself.
+std::vector<Layer> stack(const FamilyParams& p) {
+    const double width = 10.0, s = width / static_cast<double>(p.points - 1);
+    const double gap = p.gap * s;
+    const double total = gap * static_cast<double>(p.layers - 1);
+    const double amplitude = total > 0.0 ? std::min(1.0, 0.5 * 0.88 / total) : 1.0;
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < p.layers; ++k) {
+        Layer layer = make_layer("layer_" + std::to_string(k), 0.5 * gap);
+        const double offset = gap * static_cast<double>(k);
+        for (std::size_t i = 0; i < p.points; ++i) {
+            const double x = s * static_cast<double>(i);
+            const double y = amplitude * (0.5 * std::sin(0.6 * x) + 0.18 * std::sin(2.3 * x + 0.5));
+            const double slope =
+                amplitude * (0.3 * std::cos(0.6 * x) + 0.414 * std::cos(2.3 * x + 0.5));
+            const double len = std::sqrt(1.0 + slope * slope);
+            layer.points.emplace_back(x - offset * slope / len, y + offset / len);
+        }
+        layers.push_back(std::move(layer));
+    }
+    return layers;
+}
+
+// Loops: r_k(t) = 1 + k gap + 0.03 sin 7t (radial offsets of a star-shaped curve: nested,
+// never self-crossing).
+std::vector<Layer> loops(const FamilyParams& p) {
+    const double s = 2.0 * kPi / static_cast<double>(p.points), gap = p.gap * s;
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < p.layers; ++k) {
+        Layer layer = make_layer("loop_" + std::to_string(k), 0.5 * gap, true);
+        for (std::size_t i = 0; i < p.points; ++i) {
+            const double t = s * static_cast<double>(i);
+            const double r = 1.0 + gap * static_cast<double>(k) + 0.03 * std::sin(7.0 * t);
+            layer.points.emplace_back(r * std::cos(t), r * std::sin(t));
+        }
+        layers.push_back(std::move(layer));
+    }
+    return layers;
+}
+
+// Folded: a centreline of three arms of length 4 joined by two half turns of radius rho (an
+// S), sampled evenly by arc length; layer k is offset by k gap to its left. The first turn
+// bends toward the offsets (inner radius rho - (n - 1) gap = 1.5 gap), the second away.
+std::vector<Layer> folded(const FamilyParams& p) {
+    const double arm = 4.0, n = static_cast<double>(p.layers);
+    const double pts = static_cast<double>(p.points);
+    // gap = p.gap * (3 arm + 2 pi rho) / pts with rho = (n - 1) gap + 1.5 gap.
+    const double denominator = pts - p.gap * 2.0 * kPi * (n + 0.5);
+    if (!(denominator > 0.0))
+        throw InvalidInput("scene family 'folded': " + std::to_string(p.points) +
+                           " points are too few for " + std::to_string(p.layers) + " layers " +
+                           format_number(p.gap) + " segments apart");
+    const double gap = p.gap * 3.0 * arm / denominator;
+    const double rho = (n - 0.5) * gap;
+    const double turn = kPi * rho, total = 3.0 * arm + 2.0 * turn;
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < p.layers; ++k) {
+        Layer layer = make_layer("layer_" + std::to_string(k), 0.5 * gap);
+        const double off = gap * static_cast<double>(k);
+        for (std::size_t i = 0; i < p.points; ++i) {
+            double u = total * static_cast<double>(i) / (pts - 1.0);
+            Vec2 at, left;
+            if (u <= arm) {
+                at = {u, 0.0};
+                left = {0.0, 1.0};
+            } else if ((u -= arm) <= turn) {  // counter-clockwise about (arm, rho)
+                const double a = -0.5 * kPi + u / rho;
+                at = Vec2(arm, rho) + rho * Vec2(std::cos(a), std::sin(a));
+                left = -Vec2(std::cos(a), std::sin(a));
+            } else if ((u -= turn) <= arm) {
+                at = {arm - u, 2.0 * rho};
+                left = {0.0, -1.0};
+            } else if ((u -= arm) <= turn) {  // clockwise about (0, 3 rho)
+                const double a = -0.5 * kPi - u / rho;
+                at = Vec2(0.0, 3.0 * rho) + rho * Vec2(std::cos(a), std::sin(a));
+                left = Vec2(std::cos(a), std::sin(a));
+            } else {
+                u -= turn;
+                at = {std::min(u, arm), 4.0 * rho};
+                left = {0.0, 1.0};
+            }
+            layer.points.push_back(at + off * left);
+        }
+        layers.push_back(std::move(layer));
+    }
+    return layers;
+}
+
+// Rolled: the outer layer at y = gap over [0, 8]; the inner one along y = 0 to x = 9, half a
+// turn of radius 1.5 gap about (9, 1.5 gap) past the outer one's end, and back over it at
+// y = 3 gap to x = 5.
+std::vector<Layer> rolled(const FamilyParams& p) {
+    const double s = 10.0 / static_cast<double>(p.points - 1), gap = p.gap * s;
+    Layer outer = make_layer("outer", 0.5 * gap), inner = make_layer("inner", 0.5 * gap);
+    for (double x = 0.0; x <= 8.0 + 1e-9; x += s) outer.points.emplace_back(x, gap);
+    for (double x = 0.0; x < 9.0; x += s) inner.points.emplace_back(x, 0.0);
+    const double r = 1.5 * gap;
+    const int steps = std::max(4, static_cast<int>(std::ceil(kPi * r / s)));
+    for (int j = 0; j <= steps; ++j) {
+        const double a = -0.5 * kPi + kPi * j / steps;
+        inner.points.emplace_back(9.0 + r * std::cos(a), r + r * std::sin(a));
+    }
+    for (double x = 9.0 - s; x >= 5.0; x -= s) inner.points.emplace_back(x, 3.0 * gap);
+    return {inner, outer};
+}
+
+// Jacket: a body loop r = 1 + 0.02 sin 5t and, gap outside it, an open jacket over the
+// angles [pi/4, 7 pi/4] with the same waves; the body's `outer` is the jacket.
+std::vector<Layer> jacket(const FamilyParams& p) {
+    const double s = 2.0 * kPi / static_cast<double>(p.points), gap = p.gap * s;
+    Layer body = make_layer("body", 0.5 * gap, true), coat = make_layer("jacket", 0.5 * gap);
+    body.outer = std::vector<std::string>{"jacket"};
+    coat.outer = std::vector<std::string>{};
+    for (std::size_t i = 0; i < p.points; ++i) {
+        const double t = s * static_cast<double>(i), r = 1.0 + 0.02 * std::sin(5.0 * t);
+        body.points.emplace_back(r * std::cos(t), r * std::sin(t));
+    }
+    const std::size_t m = std::max<std::size_t>(3, p.points * 3 / 4);
+    for (std::size_t i = 0; i < m; ++i) {
+        const double t =
+            0.25 * kPi + 1.5 * kPi * static_cast<double>(i) / static_cast<double>(m - 1);
+        const double r = 1.0 + gap + 0.02 * std::sin(5.0 * t);
+        coat.points.emplace_back(r * std::cos(t), r * std::sin(t));
+    }
+    return {body, coat};
+}
+
+// Legs: two circles of radius 0.45, gap apart, and a skirt that keeps gap from both: the
+// capsule around them (two half circles of radius 0.45 + gap joined by straight sides).
+std::vector<Layer> legs(const FamilyParams& p) {
+    const double radius = 0.45, s = 2.0 * kPi * radius / static_cast<double>(p.points);
+    const double gap = p.gap * s, c = radius + 0.5 * gap;
+    std::vector<Layer> layers;
+    for (const double sign : {-1.0, 1.0}) {
+        Layer leg = make_layer(sign < 0.0 ? "leg_left" : "leg_right", 0.5 * gap, true);
+        leg.outer = std::vector<std::string>{"skirt"};
+        for (std::size_t i = 0; i < p.points; ++i) {
+            const double t = 2.0 * kPi * static_cast<double>(i) / static_cast<double>(p.points);
+            leg.points.emplace_back(sign * c + radius * std::cos(t), radius * std::sin(t));
+        }
+        layers.push_back(std::move(leg));
+    }
+    Layer skirt = make_layer("skirt", 0.5 * gap, true);
+    skirt.outer = std::vector<std::string>{};
+    const double r = radius + gap;
+    const std::size_t half = p.points, side = std::max<std::size_t>(2, p.points / 3);
+    auto arc = [&](double cx, double from) {
+        for (std::size_t i = 0; i < half; ++i) {
+            const double t = from + kPi * static_cast<double>(i) / static_cast<double>(half);
+            skirt.points.emplace_back(cx + r * std::cos(t), r * std::sin(t));
+        }
+    };
+    auto straight = [&](double y, double from, double to) {
+        for (std::size_t i = 0; i < side; ++i) {
+            const double x =
+                from + (to - from) * static_cast<double>(i) / static_cast<double>(side);
+            skirt.points.emplace_back(x, y);
+        }
+    };
+    arc(c, -0.5 * kPi);   // right end, bottom to top
+    straight(r, c, -c);   // top, right to left
+    arc(-c, 0.5 * kPi);   // left end, top to bottom
+    straight(-r, -c, c);  // bottom, left to right
+    layers.push_back(std::move(skirt));
+    return layers;
+}
+
+}  // namespace
+
+std::vector<SceneFamily> all_scene_families() {
+    return {SceneFamily::Stack,  SceneFamily::Loops,  SceneFamily::Folded,
+            SceneFamily::Rolled, SceneFamily::Jacket, SceneFamily::Legs};
+}
+
+std::string family_name(SceneFamily family) {
+    switch (family) {
+        case SceneFamily::Stack:
+            return "stack";
+        case SceneFamily::Loops:
+            return "loops";
+        case SceneFamily::Folded:
+            return "folded";
+        case SceneFamily::Rolled:
+            return "rolled";
+        case SceneFamily::Jacket:
+            return "jacket";
+        case SceneFamily::Legs:
+            return "legs";
+    }
+    return "?";
+}
+
+Scene make_scene(SceneFamily family, const FamilyParams& params) {
+    if (params.layers < 1 || params.points < 4)
+        throw InvalidInput("scene family '" + family_name(family) +
+                           "': layers must be >= 1 and points >= 4 (got " +
+                           std::to_string(params.layers) + ", " + std::to_string(params.points) +
+                           ")");
+    if (!(params.gap > 0.0) || !std::isfinite(params.gap))
+        throw InvalidInput("scene family '" + family_name(family) + "': gap must be > 0 (got " +
+                           format_number(params.gap) + ")");
+    if (!(params.scale > 0.0) || !std::isfinite(params.scale))
+        throw InvalidInput("scene family '" + family_name(family) + "': scale must be > 0 (got " +
+                           format_number(params.scale) + ")");
+    std::vector<Layer> layers;
+    switch (family) {
+        case SceneFamily::Stack:
+            layers = stack(params);
+            break;
+        case SceneFamily::Loops:
+            layers = loops(params);
+            break;
+        case SceneFamily::Folded:
+            layers = folded(params);
+            break;
+        case SceneFamily::Rolled:
+            layers = rolled(params);
+            break;
+        case SceneFamily::Jacket:
+            layers = jacket(params);
+            break;
+        case SceneFamily::Legs:
+            layers = legs(params);
+            break;
+    }
+    for (Layer& layer : layers) {
+        layer.thickness *= params.scale;
+        for (Vec2& point : layer.points) point = params.scale * point + params.offset;
+    }
+    return Scene(std::move(layers));
+}
+
+}  // namespace strata
