@@ -374,8 +374,9 @@ class Finisher {
     }
 
     // Exact: moving vertex (l, v) from p to `to` tunnels through nothing. The new segments
-    // (prev, to) and (to, next) may meet only segments that the old ones met (a vertex on the
-    // wrong side of a layer moves back over it one vertex at a time), and the triangles swept
+    // (prev, to) and (to, next) may meet another segment only as many times as the old ones
+    // did (a vertex on the wrong side of a layer moves back over it one vertex at a time: the
+    // crossing passes from one of its segments to the other), and the triangles swept
     // by the old segments must hold no other vertex; then no segment that the old ones did
     // not meet can have passed through the moving ones, and no new contact is made.
     bool is_safe(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) {
@@ -404,13 +405,12 @@ class Finisher {
             const Vec2 a = cells_->start(s), b = cells_->end(s);
             const bool with_prev = has_prev && !shares_end(s, prev, v);
             const bool with_next = has_next && !shares_end(s, v, next);
-            if ((with_prev && meets(pts_[l][prev], to, a, b)) ||
-                (with_next && meets(to, pts_[l][next], a, b))) {
-                // Allowed only where the old segments met it too.
-                if (!((with_prev && meets(pts_[l][prev], p, a, b)) ||
-                      (with_next && meets(p, pts_[l][next], a, b))))
-                    safe = false;
-            }
+            const int now = (with_prev && meets(pts_[l][prev], to, a, b) ? 1 : 0) +
+                            (with_next && meets(to, pts_[l][next], a, b) ? 1 : 0);
+            // Allowed only as often as the old segments met it.
+            if (now > 0 && now > (with_prev && meets(pts_[l][prev], p, a, b) ? 1 : 0) +
+                                     (with_next && meets(p, pts_[l][next], a, b) ? 1 : 0))
+                safe = false;
             const std::size_t ends[2] = {s.index, (s.index + 1) % layer_size(s.layer)};
             for (std::size_t e = 0; e < 2 && safe; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
