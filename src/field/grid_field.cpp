@@ -1,6 +1,8 @@
 // Grid backend: the layers of a scene share one OpenVDB FloatGrid, layer i at index z = i
-// (layers 8k..8k+7 in the k-th row of leaves along z), with the transform
-// createLinearTransform(h). In every leaf, layer i's band voxels hold its exact signed values and
+// (layers 8k..8k+7 in the k-th row of leaves along z), in index space (voxel (i, j) is the
+// point (i h, j h); the shared grid keeps a unit transform, since OpenVDB refuses a linear
+// transform whose determinant h^3 is near 0, as for scenes in kilometres drawn in metres, and
+// only the exported slabs carry createLinearTransform(h)). In every leaf, layer i's band voxels hold its exact signed values and
 // its other voxels the band width with layer i's sign. Points whose bilinear corners fall in no
 // leaf take layer i's sign from the first leaf voxel of its plane along +x. The only translation
 // unit of the field module that includes OpenVDB (it also writes .vdb files).
@@ -332,7 +334,13 @@ class GridStack {
     openvdb::FloatGrid::Ptr slab(std::size_t l) const {
         const auto bg = static_cast<float>(band_);
         auto grid = openvdb::FloatGrid::create(bg);
-        grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
+        try {
+            grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
+        } catch (const openvdb::ArithmeticError&) {
+            throw InvalidInput("write_vdb: the voxel size " + format_number(h_) +
+                               " is too small for an OpenVDB transform (its cube must be "
+                               "well above 1e-8); scale the scene up");
+        }
         grid->setGridClass(openvdb::GRID_LEVEL_SET);
         grid->setName(layers_[l].name);
         const int z = static_cast<int>(l), row_z = row_origin_z(l);
@@ -614,7 +622,6 @@ class GridStack {
     // per leaf), inserted serially.
     void build() {
         auto grid = StackGrid::create(static_cast<float>(band_));
-        grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
         grid->setGridClass(openvdb::GRID_LEVEL_SET);
         grid->setName("strata_layers");
         grid_ = grid;
