@@ -11,11 +11,15 @@
 // Columns: crossings and nesting violations before/after, the ratio after and its bar, time,
 // moved vertices, the largest Hausdorff distance of a layer to its un-decimated input.
 // Usage: strata_bench_untangle [--family NAME] [--tangle naive90|naive95|dp]
-//                              [--backend indexed|grid] [--points N] [--timing]
+//                              [--backend indexed|grid] [--points N] [--timing] [--write DIR]
+// --write DIR: every case's tangled input (NAME.tangled.json) and result (NAME.json, and
+// NAME.svg with the tangled input drawn faintly under it), DIR existing.
 // --timing: the two timing cases instead (12 loops x 150 and 6 x 300 stack, naive 90%).
 
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
+#include "strata/io/scene_io.h"
+#include "strata/io/svg_io.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
 #include "strata/untangle/untangle.h"
@@ -130,6 +134,8 @@ struct Row {
     bool capped = false;
 };
 
+std::string write_dir;  // --write
+
 Row run(const std::string& name, const std::string& how, const Scene& input,
         const UntangleParams& params, double cap_seconds) {
     const CheckReport original = check_scene(input);
@@ -156,6 +162,16 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
         hausdorff = std::max(
             hausdorff,
             strata::hausdorff(scene.layer(l), input.layer(l), 1e-4 * diagonal).symmetric());
+    if (!write_dir.empty()) {
+        std::string file = name + "-" + how;
+        std::replace(file.begin(), file.end(), ' ', '_');
+        const std::string base = write_dir + "/" + file;
+        write_scene(tangled, base + ".tangled.json");
+        write_scene(scene, base + ".json");
+        SvgWriteParams svg;
+        svg.underlay = &tangled;
+        write_scene_svg(scene, base + ".svg", svg);
+    }
     std::printf("%-22s %-8s %5zux%-5zu %5zu/%-5zu %5zu/%-5zu %7.3f %6.3f %8.3f %8zu %10.3g %5s%s\n",
                 name.c_str(), how.c_str(), tangled.size(), tangled.vertex_count() / tangled.size(),
                 before.crossing_count, after.crossing_count, before.nesting_violation_count,
@@ -205,10 +221,13 @@ int main(int argc, char** argv) {
             points = static_cast<std::size_t>(std::stoul(value()));
         else if (key == "--timing")
             timed = true;
+        else if (key == "--write")
+            write_dir = value();
         else {
             std::fprintf(stderr,
                          "usage: strata_bench_untangle [--family NAME] [--tangle "
-                         "naive90|naive95|dp] [--backend indexed|grid] [--points N] [--timing]\n");
+                         "naive90|naive95|dp] [--backend indexed|grid] [--points N] [--timing] "
+                         "[--write DIR]\n");
             return 2;
         }
     }

@@ -183,7 +183,7 @@ class Finisher {
             auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
             std::nth_element(lengths.begin(), mid, lengths.end());
             cell = std::max(cell, *mid);
-            tangle_reach_ = std::max(reach_, *mid);
+            tangle_reach_ = params_.tangle_reach * *mid;
         }
         tangle_reach_ = std::max(tangle_reach_, reach_);
         cell = std::max(cell, tangle_reach_);

@@ -27,6 +27,12 @@ struct SeparationParams {
     int max_sweeps = 60;  ///< Gauss-Seidel sweeps over all constraints, at most. >= 1.
     /// A sweep that leaves every pair within this fraction of its aim ends the stage.
     double tolerance = 0.02;
+    /// Vertices on the wrong side of another layer are seen (and pushed back over it) up to
+    /// max(largest aim, this many median segment lengths of the work scene) from it; 0: only
+    /// within the aims. (0 and 0.5 were tried for untangle(), where nothing rolls a bad
+    /// result back: no more scenes of strata_bench_untangle came out clean, and 0 left the
+    /// small folded stack of the tests tangled.)
+    double tangle_reach = 1.0;
     /// Leave the scene as it is when a close vertex lies on the wrong side of another layer
     /// (a tangle the projection has yet to take out): the run then costs one measuring sweep.
     bool only_when_untangled = false;
