@@ -3,12 +3,15 @@
 #include "commands.h"
 
 #include "strata/core/error.h"
+#include "strata/core/format.h"
 #include "strata/geometry/checks.h"
 #include "strata/io/atomic_file.h"
 #include "strata/io/scene_io.h"
 #include "strata/io/svg_io.h"
 #include "strata/simplify/simplify.h"
+#include "strata/untangle/untangle.h"
 
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
@@ -28,6 +31,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// What to do with an input that already crosses (or breaks its nesting).
+enum class InputCrossings { Untangle, Skip, Fail };
+
 struct SimplifyOptions {
     std::vector<std::string> inputs;
     std::string output, svg, report;
@@ -36,6 +42,8 @@ struct SimplifyOptions {
     bool no_shape_matching = false;
     bool no_finish = false;
     bool naive = false;
+    bool compare_naive = false;  // also run the naive decimation, for the numbers
+    InputCrossings input_crossings = InputCrossings::Untangle;
     SimplifyParams params;
 };
 
@@ -84,6 +92,13 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
     return j;
 }
 
+// Peak resident memory of this process so far, MiB (getrusage).
+double peak_memory_mib() {
+    rusage usage{};
+    if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux: KiB
+}
+
 double max_hausdorff(const SimplifyReport& r) {
     double h = 0.0;
     for (const LayerSimplifyReport& l : r.layers) h = std::max(h, l.hausdorff);
@@ -110,11 +125,10 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
     std::printf(
         "min separation ratio %.4g; max Hausdorff %.4g; removals %zu, set aside %zu, untangled "
         "%zu in %zu batches, refused %zu (%zu gave up early); time %.3f s (decimate %.3f, fields "
-        "%.3f, untangle "
-        "%.3f, check %.3f)\n",
+        "%.3f, untangle %.3f, finish %.3f, check %.3f); peak memory %.0f MiB\n",
         r.min_separation_ratio, max_hausdorff(r), r.removed, r.deferred, r.untangle_calls,
         r.batches, r.refused, r.gave_up, r.seconds_total, r.seconds_decimate, r.seconds_fields,
-        r.seconds_untangle, r.seconds_check);
+        r.seconds_untangle, r.seconds_finish, r.seconds_check, peak_memory_mib());
     if (!r.collision_free)
         std::fprintf(
             stderr,
@@ -129,35 +143,108 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             name.c_str(), r.refused);
 }
 
-// Simplification keeps a collision-free scene so; an input that already crosses is refused.
-void require_collision_free(const Scene& input, const std::string& name) {
+// What was done to an input that already crossed before it was simplified.
+struct InputUntangling {
+    std::size_t crossings = 0, nesting_violations = 0;  // of the input
+    UntangleReport report;
+};
+
+// One line on what is wrong with `check` (an input's), naming the first culprit.
+std::string tangle_summary(const Scene& scene, const CheckReport& check) {
+    std::string text = std::to_string(check.crossing_count) + " crossings between layers, " +
+                       std::to_string(check.total_self_crossings()) + " self-crossings, " +
+                       std::to_string(check.nesting_violation_count) + " nesting violations";
+    if (!check.crossings.empty()) {
+        const Crossing& c = check.crossings.front();
+        text += "; first: layer '" + scene.layer(c.layer_a).name + "' segment " +
+                std::to_string(c.segment_a) + " x layer '" + scene.layer(c.layer_b).name +
+                "' segment " + std::to_string(c.segment_b) + " at (" +
+                format_number(c.point.x) + ", " + format_number(c.point.y) + ")";
+    } else if (!check.self_crossings.empty()) {
+        const Crossing& c = check.self_crossings.front();
+        text += "; first: layer '" + scene.layer(c.layer_a).name + "' crosses itself (segments " +
+                std::to_string(c.segment_a) + " and " + std::to_string(c.segment_b) + " at (" +
+                format_number(c.point.x) + ", " + format_number(c.point.y) + "))";
+    } else if (!check.nesting_violations.empty()) {
+        const NestingViolation& v = check.nesting_violations.front();
+        text += "; first: layer '" + scene.layer(v.layer).name + "' point " +
+                std::to_string(v.vertex) + " on the wrong side of layer '" +
+                scene.layer(v.other).name + "'";
+    }
+    return text;
+}
+
+// Simplification keeps a collision-free scene so. An input that already crosses is untangled
+// first (InputCrossings::Untangle: the global untangling, which cannot mend a layer that
+// crosses itself), or refused (Fail: InvalidInput; Skip: std::nullopt).
+std::optional<Scene> prepare_input(const Scene& input, const std::string& name,
+                                   InputCrossings mode, const SimplifyParams& params,
+                                   std::optional<InputUntangling>& untangled) {
     const CheckReport before = check_scene(input);
-    if (!before.is_collision_free())
-        throw InvalidInput(name + ": input already crosses (" +
-                           std::to_string(before.crossing_count) + " crossings, " +
-                           std::to_string(before.nesting_violation_count) +
-                           " nesting violations); not simplified (run 'strata untangle' first)");
+    if (before.is_collision_free()) return input;
+    const std::string what = tangle_summary(input, before);
+    if (mode == InputCrossings::Skip) return std::nullopt;
+    if (mode == InputCrossings::Fail || before.total_self_crossings() > 0)
+        throw InvalidInput(name + ": the input is not collision-free (" + what + ")" +
+                           (mode == InputCrossings::Fail
+                                ? "; not simplified (--input-crossings untangle mends it first)"
+                                : "; a layer that crosses itself cannot be untangled"));
+    Scene scene = input;
+    UntangleParams u = params.untangling;
+    // The global untangling's own pass structure (untangle()'s defaults), the driver's field
+    // and shape settings.
+    const UntangleParams defaults;
+    u.gradient_steps = defaults.gradient_steps;
+    u.max_rounds = defaults.max_rounds;
+    u.max_passes = defaults.max_passes;
+    u.give_up_when_stalled = false;
+    InputUntangling info;
+    info.crossings = before.crossing_count;
+    info.nesting_violations = before.nesting_violation_count;
+    info.report = untangle(scene, u);
+    const CheckReport after = check_scene(scene);
+    if (!after.is_collision_free())
+        throw InvalidInput(name + ": the input is not collision-free (" + what +
+                           ") and untangling it left " + tangle_summary(scene, after) +
+                           "; not simplified");
+    untangled = info;
+    return scene;
+}
+
+nlohmann::json untangling_json(const InputUntangling& u) {
+    return {{"crossings", u.crossings},
+            {"nesting_violations", u.nesting_violations},
+            {"moved_vertices", u.report.moved_vertices},
+            {"max_displacement", u.report.max_displacement},
+            {"min_separation_ratio_after", finite_or_null(u.report.min_separation_ratio_after)},
+            {"passes", u.report.passes},
+            {"seconds", u.report.seconds_fields + u.report.seconds_untangle +
+                            u.report.seconds_finish + u.report.seconds_check}};
 }
 
 struct Outcome {
     std::string input, output;
     std::optional<SimplifyReport> report, naive;
+    std::optional<InputUntangling> untangled;  // the input crossed and was untangled first
+    bool skipped = false;                      // the input crossed (--input-crossings skip)
     std::string error;
 };
 
-// Simplifies one scene; the naive run (no untangling) is made beside it for the numbers.
+// Simplifies one scene; the naive run (no untangling) is made beside it when asked for.
 Outcome run_one(const Scene& input, const SimplifyOptions& opt, const ProgressFn& progress,
                 Scene& result, Scene* naive_result) {
     Outcome out;
-    SimplifyParams naive_params = opt.params;
-    naive_params.untangle = false;
-    Scene naive = input;
-    out.naive = simplify(naive, naive_params);
-    if (naive_result) *naive_result = naive;
-    if (opt.naive) {
-        result = naive;
-        out.report = out.naive;
-        return out;
+    if (opt.compare_naive || opt.naive) {
+        SimplifyParams naive_params = opt.params;
+        naive_params.untangle = false;
+        Scene naive = input;
+        out.naive = simplify(naive, naive_params);
+        if (naive_result) *naive_result = naive;
+        if (opt.naive) {
+            result = naive;
+            out.report = out.naive;
+            return out;
+        }
     }
     result = input;
     out.report = simplify(result, opt.params, progress);
@@ -169,7 +256,9 @@ int run_demo(const SimplifyOptions& opt) {
     fs::create_directories(dir);
     const Scene input = demo_scene();
     Scene result, naive;
-    const Outcome o = run_one(input, opt, terminal_progress(), result, &naive);
+    SimplifyOptions demo = opt;
+    demo.compare_naive = true;  // the demo shows what naive decimation does
+    const Outcome o = run_one(input, demo, terminal_progress(), result, &naive);
     write_scene(input, dir / "input.json");
     write_scene(naive, dir / "naive.json");
     write_scene(result, dir / "strata.json");
@@ -182,7 +271,9 @@ int run_demo(const SimplifyOptions& opt) {
              {"naive decimation: layers cross", &naive, &input},
              {"strata: collision-free", &result, &input}},
             svg));
-    write_file_atomic(dir / "report.json", report_json(*o.report, &*o.naive).dump(2) + "\n");
+    nlohmann::json j = report_json(*o.report, &*o.naive);
+    j["peak_memory_mib"] = peak_memory_mib();
+    write_file_atomic(dir / "report.json", j.dump(2) + "\n");
     std::printf(
         "demo: 5 stacked cloth-like layers, %zu vertices; outputs in %s/ (input.json, naive.json, "
         "strata.json, compare.svg, report.json)\n",
@@ -219,10 +310,15 @@ int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files)
         o.output = (fs::path(opt.output) / (fs::path(files[i]).stem().string() + ".json")).string();
         try {
             ensure_not_an_input(o.output, {fs::path(files[i])});
-            const Scene input = with_default_thickness(read_scene(files[i]), opt.thickness);
-            require_collision_free(input, files[i]);
+            const Scene read = with_default_thickness(read_scene(files[i]), opt.thickness);
+            const std::optional<Scene> input =
+                prepare_input(read, files[i], opt.input_crossings, opt.params, o.untangled);
+            if (!input) {
+                o.skipped = true;
+                return;
+            }
             Scene result;
-            Outcome r = run_one(input, opt, {}, result, nullptr);
+            Outcome r = run_one(*input, opt, {}, result, nullptr);
             write_scene(result, o.output);
             o.report = std::move(r.report);
             o.naive = std::move(r.naive);
@@ -230,9 +326,9 @@ int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files)
             o.error = e.what();
         }
     });
-    std::printf("%-40s %8s %8s %7s %7s %8s %9s %8s\n", "slice", "before", "after", "naive-x",
-                "strata-x", "refused", "hausdorff", "time-s");
-    std::size_t failed = 0, tangled = 0;
+    std::printf("%-40s %8s %8s %7s %7s %7s %8s %9s %8s\n", "slice", "before", "after", "input-x",
+                "naive-x", "strata-x", "refused", "hausdorff", "time-s");
+    std::size_t failed = 0, tangled = 0, skipped = 0, untangled = 0;
     nlohmann::json all = nlohmann::json::array();
     for (const Outcome& o : outcomes) {
         const std::string name = fs::path(o.input).filename().string();
@@ -242,26 +338,38 @@ int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files)
             all.push_back({{"input", o.input}, {"error", o.error}});
             continue;
         }
+        if (o.skipped) {
+            ++skipped;
+            std::printf("%-40s skipped: the input crosses (--input-crossings skip)\n",
+                        name.c_str());
+            all.push_back({{"input", o.input}, {"skipped", true}});
+            continue;
+        }
+        if (o.untangled) ++untangled;
         std::size_t before = 0, after = 0;
         for (const LayerSimplifyReport& l : o.report->layers) {
             before += l.before;
             after += l.after;
         }
         if (!o.report->collision_free) ++tangled;
-        std::printf("%-40s %8zu %8zu %7zu %7zu %8zu %9.3g %8.3f\n", name.c_str(), before, after,
-                    o.naive->crossings, o.report->crossings, o.report->refused,
-                    max_hausdorff(*o.report), o.report->seconds_total);
-        nlohmann::json j = report_json(*o.report, &*o.naive);
+        std::printf("%-40s %8zu %8zu %7s %7s %7zu %8zu %9.3g %8.3f\n", name.c_str(), before,
+                    after, o.untangled ? std::to_string(o.untangled->crossings).c_str() : "0",
+                    o.naive ? std::to_string(o.naive->crossings).c_str() : "-",
+                    o.report->crossings, o.report->refused, max_hausdorff(*o.report),
+                    o.report->seconds_total);
+        nlohmann::json j = report_json(*o.report, o.naive ? &*o.naive : nullptr);
         j["input"] = o.input;
         j["output"] = o.output;
+        if (o.untangled) j["input_untangled"] = untangling_json(*o.untangled);
         all.push_back(j);
     }
     std::printf(
-        "%zu slices: %zu simplified, %zu failed (nothing written for them), %zu not "
-        "collision-free\n",
-        outcomes.size(), outcomes.size() - failed, failed, tangled);
+        "%zu slices: %zu simplified (%zu of them untangled first), %zu skipped, %zu failed "
+        "(nothing written for them), %zu not collision-free; peak memory %.0f MiB\n",
+        outcomes.size(), outcomes.size() - failed - skipped, untangled, skipped, failed, tangled,
+        peak_memory_mib());
     if (!opt.report.empty()) write_file_atomic(opt.report, all.dump(2) + "\n");
-    return failed == 0 && tangled == 0 ? 0 : 1;
+    return failed == 0 && tangled == 0 && skipped == 0 ? 0 : 1;
 }
 
 }  // namespace
@@ -314,10 +422,22 @@ Run add_simplify_command(CLI::App& app) {
     cmd->add_flag("--global", p.global,
                   "Untangle the whole scene after each tangling removal (slow; comparison)");
     cmd->add_flag("--no-untangle", opt->naive, "Naive decimation only");
+    cmd->add_flag("--compare-naive", opt->compare_naive,
+                  "Also run the naive decimation, for its numbers (the demo always does)");
+    static const std::map<std::string, InputCrossings> crossing_modes{
+        {"untangle", InputCrossings::Untangle},
+        {"skip", InputCrossings::Skip},
+        {"fail", InputCrossings::Fail}};
+    add_choice_option(*cmd, "--input-crossings", opt->input_crossings, crossing_modes,
+                      "An input that already crosses: untangle it first (global untangling), "
+                      "skip it (batch; one input: exit 1, nothing written) or fail (exit 2)",
+                      "untangle");
     cmd->add_flag("--no-shape-matching", opt->no_shape_matching, "Pure projection");
     cmd->add_flag("--no-finish", opt->no_finish,
                   "Untangle without the finishing stage (exact separation constraints)");
-    cmd->add_option("--svg", opt->svg, "Picture: input / naive / strata (one input)");
+    cmd->add_option("--svg", opt->svg,
+                    "Picture: input / strata, with --compare-naive input / naive / strata (one "
+                    "input)");
     cmd->add_option("--report", opt->report, "Report as JSON");
     return [opt, decimator]() {
         SimplifyOptions o = *opt;
@@ -342,22 +462,44 @@ Run add_simplify_command(CLI::App& app) {
         const Scene input = with_default_thickness(read_scene(files.front()), o.thickness);
         for (const std::string& note : input.diagnostics().notes)
             std::cerr << "strata: note: " << files.front() << ": " << note << '\n';
-        require_collision_free(input, files.front());
+        const std::string name = fs::path(files.front()).filename().string();
+        std::optional<InputUntangling> untangled;
+        const std::optional<Scene> prepared =
+            prepare_input(input, files.front(), o.input_crossings, o.params, untangled);
+        if (!prepared) {
+            std::fprintf(stderr,
+                         "strata: %s: the input crosses; skipped (--input-crossings skip), "
+                         "nothing written\n",
+                         files.front().c_str());
+            return 1;
+        }
+        if (untangled)
+            std::printf(
+                "%s: the input crossed (%zu crossings, %zu nesting violations): untangled first "
+                "(%zu vertices moved, at most %.4g; gap ratio %.4g; %d passes)\n",
+                name.c_str(), untangled->crossings, untangled->nesting_violations,
+                untangled->report.moved_vertices, untangled->report.max_displacement,
+                untangled->report.min_separation_ratio_after, untangled->report.passes);
         Scene result, naive;
-        const Outcome out = run_one(input, o, terminal_progress(), result, &naive);
+        const Outcome out = run_one(*prepared, o, terminal_progress(), result, &naive);
         write_scene(result, o.output);
+        const SimplifyReport* naive_report = out.naive ? &*out.naive : nullptr;
         if (!o.svg.empty()) {
             SvgWriteParams svg;
             svg.width_px = 1000.0;
-            write_file_atomic(
-                o.svg, panels_to_svg({{"input", &input, nullptr},
-                                      {"naive decimation", &naive, &input},
-                                      {o.naive ? "naive decimation" : "strata", &result, &input}},
-                                     svg));
+            std::vector<SvgPanel> panels{{untangled ? "input (crossing)" : "input", &input, nullptr}};
+            if (untangled) panels.push_back({"input untangled", &*prepared, &input});
+            if (naive_report && !o.naive) panels.push_back({"naive decimation", &naive, &input});
+            panels.push_back({o.naive ? "naive decimation" : "strata", &result, &input});
+            write_file_atomic(o.svg, panels_to_svg(panels, svg));
         }
-        if (!o.report.empty())
-            write_file_atomic(o.report, report_json(*out.report, &*out.naive).dump(2) + "\n");
-        print_summary(fs::path(files.front()).filename().string(), *out.report, &*out.naive);
+        if (!o.report.empty()) {
+            nlohmann::json j = report_json(*out.report, naive_report);
+            if (untangled) j["input_untangled"] = untangling_json(*untangled);
+            j["peak_memory_mib"] = peak_memory_mib();
+            write_file_atomic(o.report, j.dump(2) + "\n");
+        }
+        print_summary(name, *out.report, naive_report);
         return out.report->collision_free ? 0 : 1;
     };
 }
