@@ -10,7 +10,6 @@
 #endif
 #include <boost/geometry/geometries/box.hpp>
 #include <boost/geometry/geometries/point.hpp>
-#include <boost/geometry/geometries/segment.hpp>
 #include <boost/geometry/index/rtree.hpp>
 #include <boost/geometry/strategies/strategies.hpp>
 
@@ -31,12 +30,9 @@ namespace bgi = boost::geometry::index;
 
 using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
 using BBox = bg::model::box<BPoint>;
-using BSegment = bg::model::segment<BPoint>;
-// Broad phases on boxes (exact comparisons); nearest queries on the segments themselves.
+// Broad phases on boxes (exact comparisons); nearest queries in a uniform grid of segments.
 using Entry = std::pair<BBox, std::size_t>;  // a segment's box and its index
 using Tree = bgi::rtree<Entry, bgi::quadratic<16>>;
-using SegmentEntry = std::pair<BSegment, std::size_t>;
-using SegmentTree = bgi::rtree<SegmentEntry, bgi::quadratic<16>>;
 
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -44,10 +40,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 BBox segment_box(const Vec2& a, const Vec2& b) {
     return BBox(BPoint(std::min(a.x, b.x), std::min(a.y, b.y)),
                 BPoint(std::max(a.x, b.x), std::max(a.y, b.y)));
-}
-
-BSegment segment_of(const Vec2& a, const Vec2& b) {
-    return BSegment(BPoint(a.x, a.y), BPoint(b.x, b.y));
 }
 
 bool lex_less(const Vec2& a, const Vec2& b) {
@@ -68,20 +60,14 @@ class SegmentIndex {
             if (layer.segment_start(s) != layer.segment_end(s)) add(s);
         if (segments_.empty() && count > 0) add(0);
         std::vector<Entry> boxes;
-        std::vector<SegmentEntry> pieces;
         boxes.reserve(segments_.size());
-        pieces.reserve(segments_.size());
-        for (std::size_t s : segments_) {
-            boxes.emplace_back(segment_box(start(s), end(s)), s);
-            pieces.emplace_back(segment_of(start(s), end(s)), s);
-        }
+        for (std::size_t s : segments_) boxes.emplace_back(segment_box(start(s), end(s)), s);
         tree_ = Tree(boxes.begin(), boxes.end());  // packing construction
-        segment_tree_ = SegmentTree(pieces.begin(), pieces.end());
+        build_cells();
     }
 
     const Layer& layer() const { return *layer_; }
     const Tree& tree() const { return tree_; }
-    const SegmentTree& segment_tree() const { return segment_tree_; }
     /// Indices of the kept segments, increasing.
     const std::vector<std::size_t>& segments() const { return segments_; }
     Vec2 start(std::size_t s) const { return layer_->segment_start(s); }
@@ -101,41 +87,121 @@ class SegmentIndex {
     bool is_first(std::size_t s) const { return segments_.front() == s; }
     bool is_last(std::size_t s) const { return segments_.back() == s; }
 
+    struct Nearest {
+        double distance = kInf;
+        std::size_t segment = kNone;
+        Vec2 point{0.0};
+        bool found() const { return segment != kNone; }
+    };
+
+    /// The closest point of the layer to `p` if closer than `cutoff` (the segment of smallest
+    /// index among equally close ones): the cells around p's, ring by ring, until the next
+    /// ring cannot hold anything closer.
+    Nearest nearest(const Vec2& p, double cutoff) const {
+        Nearest best;
+        if (segments_.empty()) return best;
+        const long cx = column(p.x), cy = row(p.y);
+        const long rings = static_cast<long>(std::max(nx_, ny_));
+        for (long r = 0; r <= rings; ++r) {
+            // Cells at Chebyshev distance r from (cx, cy) around the clamped start cell.
+            for (long iy = cy - r; iy <= cy + r; ++iy) {
+                if (iy < 0 || iy >= static_cast<long>(ny_)) continue;
+                const bool edge_row = iy == cy - r || iy == cy + r;
+                for (long ix = cx - r; ix <= cx + r; ix += edge_row ? 1 : 2 * r) {
+                    if (ix >= 0 && ix < static_cast<long>(nx_)) visit(ix, iy, p, best);
+                    if (r == 0) break;
+                }
+            }
+            // Every cell not visited yet lies at least r h from p (p, or its projection on the
+            // grid's bounds, is in the start cell).
+            const double reach = static_cast<double>(r) * h_;
+            if (best.distance <= reach || reach >= cutoff) break;
+        }
+        if (!(best.distance < cutoff)) return Nearest{};
+        return best;
+    }
+
   private:
     void add(std::size_t s) {
         position_[s] = segments_.size();
         segments_.push_back(s);
     }
 
+    // A uniform grid over the layer's bounds (about the median segment length, at most four
+    // cells a segment), each kept segment filed in the cells its box meets (compressed rows).
+    void build_cells() {
+        if (segments_.empty()) return;
+        std::vector<double> lengths;
+        for (std::size_t s : segments_) {
+            origin_.extend(start(s));
+            origin_.extend(end(s));
+            lengths.push_back(glm_length(end(s) - start(s)));
+        }
+        auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+        std::nth_element(lengths.begin(), mid, lengths.end());
+        const Vec2 size = origin_.size();
+        h_ = std::max({*mid, 1e-9 * std::max(size.x, size.y),
+                       std::numeric_limits<double>::min()});
+        const double budget = 4.0 * static_cast<double>(segments_.size()) + 16.0;
+        while ((size.x / h_ + 1.0) * (size.y / h_ + 1.0) > budget) h_ *= 2.0;
+        nx_ = static_cast<std::size_t>(size.x / h_) + 1;
+        ny_ = static_cast<std::size_t>(size.y / h_) + 1;
+        cell_start_.assign(nx_ * ny_ + 1, 0);
+        auto each_cell = [&](std::size_t s, auto&& f) {
+            const Vec2 a = start(s), b = end(s);
+            for (long iy = row(std::min(a.y, b.y)); iy <= row(std::max(a.y, b.y)); ++iy)
+                for (long ix = column(std::min(a.x, b.x)); ix <= column(std::max(a.x, b.x)); ++ix)
+                    f(static_cast<std::size_t>(iy) * nx_ + static_cast<std::size_t>(ix));
+        };
+        for (std::size_t s : segments_) each_cell(s, [&](std::size_t c) { ++cell_start_[c + 1]; });
+        for (std::size_t c = 0; c < nx_ * ny_; ++c) cell_start_[c + 1] += cell_start_[c];
+        cell_ids_.resize(cell_start_.back());
+        std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+        for (std::size_t s : segments_) each_cell(s, [&](std::size_t c) { cell_ids_[fill[c]++] = s; });
+    }
+    static double glm_length(const Vec2& v) { return std::hypot(v.x, v.y); }
+    long column(double x) const { return clamp_cell((x - origin_.min.x) / h_, nx_); }
+    long row(double y) const { return clamp_cell((y - origin_.min.y) / h_, ny_); }
+    static long clamp_cell(double v, std::size_t n) {
+        if (!(v > 0.0)) return 0;  // NaN too
+        return static_cast<long>(std::min(v, static_cast<double>(n - 1)));
+    }
+    void visit(long ix, long iy, const Vec2& p, Nearest& best) const {
+        const std::size_t c = static_cast<std::size_t>(iy) * nx_ + static_cast<std::size_t>(ix);
+        if (cell_start_[c] == cell_start_[c + 1]) return;
+        // Nothing in a cell farther than the best so far can beat it.
+        const double x0 = origin_.min.x + static_cast<double>(ix) * h_;
+        const double y0 = origin_.min.y + static_cast<double>(iy) * h_;
+        const double dx = std::max({x0 - p.x, 0.0, p.x - (x0 + h_)});
+        const double dy = std::max({y0 - p.y, 0.0, p.y - (y0 + h_)});
+        if (dx * dx + dy * dy > best.distance * best.distance) return;
+        for (std::size_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+            const std::size_t s = cell_ids_[k];
+            Vec2 closest;
+            const double d = point_segment_distance(p, start(s), end(s), &closest);
+            if (d < best.distance || (d == best.distance && s < best.segment)) {
+                best.distance = d;
+                best.segment = s;
+                best.point = closest;
+            }
+        }
+    }
+
     const Layer* layer_ = nullptr;
     std::vector<std::size_t> segments_;
     std::vector<std::size_t> position_;
     Tree tree_;
-    SegmentTree segment_tree_;
+    Box2 origin_;  // the grid's bounds
+    double h_ = 1.0;
+    std::size_t nx_ = 1, ny_ = 1;
+    std::vector<std::size_t> cell_start_, cell_ids_;
 };
 
-struct Nearest {
-    double distance = kInf;
-    std::size_t segment = kNone;
-    Vec2 point{0.0};
-    bool found() const { return segment != kNone; }
-};
+using Nearest = SegmentIndex::Nearest;
 
-// Closest point of the indexed layer to `p` if closer than `cutoff`: one best-first nearest
-// query of the rtree, whose leaves are the segments themselves.
+// Closest point of the indexed layer to `p` if closer than `cutoff`.
 Nearest nearest_on(const SegmentIndex& index, const Vec2& p, double cutoff = kInf) {
-    Nearest best;
-    SegmentEntry found;
-    if (index.segment_tree().query(bgi::nearest(BPoint(p.x, p.y), 1), &found) == 0) return best;
-    Vec2 closest;
-    const double d =
-        point_segment_distance(p, index.start(found.second), index.end(found.second), &closest);
-    if (d < cutoff) {
-        best.distance = d;
-        best.segment = found.second;
-        best.point = closest;
-    }
-    return best;
+    return index.nearest(p, cutoff);
 }
 
 double automatic_near(const Scene& scene) {
@@ -424,7 +490,10 @@ class Checker {
                 auto scan = [&](std::size_t from, std::size_t to, bool from_is_a) {
                     const std::vector<Vec2>& points = scene_.layer(from).points;
                     for (std::size_t k = 0; k < points.size(); ++k) {
-                        const Nearest nr = nearest_on(indices_[to], points[k], cutoff);
+                        // Only a vertex closer than the pair's gap so far, or than required,
+                        // changes anything: the search stops there.
+                        const double bound = std::max(threshold, std::min(cutoff, pair.gap));
+                        const Nearest nr = nearest_on(indices_[to], points[k], bound);
                         if (!nr.found()) continue;
                         if (nr.distance < pair.gap) {
                             pair.gap = nr.distance;
