@@ -133,7 +133,7 @@ struct SceneFilter {
     std::string schedule;                                           // "": deferred and immediate
     std::vector<std::size_t> batches{0};  // each strata run at each; 0: SimplifyParams' default
     std::vector<std::size_t> threads{0};  // each strata run at each; 0: TBB's default
-    std::vector<std::size_t> give_up{1};  // give_up_when_stalled off (0) / on (1), each
+    std::vector<std::size_t> give_up{0};  // give_up_when_stalled off (0) / on (1), each
     std::vector<std::size_t> finish{1};   // finish_separations off (0) / on (1), each
     std::string decimator = "random";     // the paper's experiments
     bool closed = false;                  // wavy_loops instead of folded_stack
