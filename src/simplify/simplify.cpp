@@ -1,5 +1,7 @@
 #include "strata/simplify/simplify.h"
 
+#include "simplify/detail/segment_grid.h"
+#include "simplify/detail/work_layer.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
@@ -7,9 +9,9 @@
 #include "strata/simplify/decimator.h"
 #include "untangle/detail/engine.h"
 
-#include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -26,117 +28,14 @@ namespace strata {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+using detail::kNone;
+using detail::SegmentGrid;
+using detail::SegRef;
+using detail::WorkLayer;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
-
-struct SegRef {
-    std::uint32_t layer = 0, start = 0;  // segment from vertex `start` to its next alive vertex
-};
-
-// Uniform grid of segments (by bounding box), updated as vertices move or go. Its cells are a
-// dense array over `bounds` when that holds at most kDenseCellsPerSegment cells per segment
-// (stacks whose layers fill their box: no hashing, neighbouring cells side by side in
-// memory), a hash map elsewhere.
-class SegmentGrid {
-  public:
-    explicit SegmentGrid(double cell) : cell_(cell) {}
-    SegmentGrid(double cell, const Box2& bounds, std::size_t segments) : cell_(cell) {
-        if (bounds.is_empty()) return;
-        const long long x0 = coord(bounds.min.x), x1 = coord(bounds.max.x);
-        const long long y0 = coord(bounds.min.y), y1 = coord(bounds.max.y);
-        const double cells = static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1);
-        if (cells > static_cast<double>(kDenseCellsPerSegment * segments + 1024)) return;
-        x0_ = x0;
-        y0_ = y0;
-        nx_ = x1 - x0 + 1;
-        ny_ = y1 - y0 + 1;
-        dense_.resize(static_cast<std::size_t>(nx_ * ny_));
-    }
-    double cell() const { return cell_; }
-    /// Empties every cell, keeping the cells and their capacity for the next fill.
-    void clear() {
-        for (auto& cell : dense_) cell.clear();
-        for (auto& cell : cells_) cell.second.clear();
-    }
-
-    void insert(SegRef s, const Box2& box) {
-        for_cells(box, [&](long long ix, long long iy) { slot(ix, iy).push_back(s); });
-    }
-    void erase(SegRef s, const Box2& box) {
-        for_cells(box, [&](long long ix, long long iy) {
-            std::vector<SegRef>* v = find(ix, iy);
-            if (!v) return;
-            for (std::size_t i = 0; i < v->size(); ++i)
-                if ((*v)[i].layer == s.layer && (*v)[i].start == s.start) {
-                    (*v)[i] = v->back();
-                    v->pop_back();
-                    break;
-                }
-        });
-    }
-    // Calls f(SegRef) for the segments of the cells `box` touches (with repeats).
-    template <class F>
-    void query(const Box2& box, F&& f) const {
-        for_cells(box, [&](long long ix, long long iy) {
-            const std::vector<SegRef>* v = find(ix, iy);
-            if (!v) return;
-            for (const SegRef& s : *v) f(s);
-        });
-    }
-
-  private:
-    static constexpr std::size_t kDenseCellsPerSegment = 4;
-
-    template <class F>
-    void for_cells(const Box2& box, F&& f) const {
-        const auto x0 = coord(box.min.x), x1 = coord(box.max.x);
-        const auto y0 = coord(box.min.y), y1 = coord(box.max.y);
-        for (auto ix = x0; ix <= x1; ++ix)
-            for (auto iy = y0; iy <= y1; ++iy) f(ix, iy);
-    }
-    long long coord(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
-    bool in_dense(long long ix, long long iy) const {
-        return ix >= x0_ && ix < x0_ + nx_ && iy >= y0_ && iy < y0_ + ny_;
-    }
-    static std::uint64_t key(long long ix, long long iy) {
-        return (static_cast<std::uint64_t>(ix) << 32) ^
-               (static_cast<std::uint64_t>(iy) & 0xffffffffULL);
-    }
-    std::vector<SegRef>& slot(long long ix, long long iy) {
-        if (in_dense(ix, iy)) return dense_[static_cast<std::size_t>((ix - x0_) * ny_ + (iy - y0_))];
-        return cells_[key(ix, iy)];
-    }
-    const std::vector<SegRef>* find(long long ix, long long iy) const {
-        if (in_dense(ix, iy)) return &dense_[static_cast<std::size_t>((ix - x0_) * ny_ + (iy - y0_))];
-        const auto it = cells_.find(key(ix, iy));
-        return it == cells_.end() ? nullptr : &it->second;
-    }
-    std::vector<SegRef>* find(long long ix, long long iy) {
-        return const_cast<std::vector<SegRef>*>(std::as_const(*this).find(ix, iy));
-    }
-
-    double cell_;
-    long long x0_ = 0, y0_ = 0, nx_ = 0, ny_ = 0;  // the dense box of cells (empty: none)
-    std::vector<std::vector<SegRef>> dense_;
-    std::unordered_map<std::uint64_t, std::vector<SegRef>> cells_;  // the cells outside it
-};
-
-// A layer being decimated: a doubly linked list over the input vertex ids.
-struct WorkLayer {
-    bool closed = false;
-    std::vector<Vec2> original, pos;
-    std::vector<std::size_t> prev, next;
-    std::vector<char> alive, locked;
-    std::size_t alive_count = 0, target = 0;
-    std::size_t first() const {  // an alive vertex to start walking from
-        for (std::size_t i = 0; i < alive.size(); ++i)
-            if (alive[i]) return i;
-        return kNone;
-    }
-};
 
 struct Candidate {
     double cost;
@@ -389,7 +288,7 @@ class Driver {
     struct Overlay {
         const Job* job = nullptr;
         const Scene* work = nullptr;
-        const SegmentGrid* moving = nullptr;  // the job's moving segments where they are now
+        const SegmentGrid* moving = nullptr;   // the job's moving segments where they are now
         std::vector<SegRef>* found = nullptr;  // the job's scratch for near()
     };
 
@@ -799,8 +698,7 @@ class Driver {
                 // Open layers keep their end vertices where they are.
                 const bool is_end = !parent_work.closed && (parent_work.prev[id] == kNone ||
                                                             parent_work.next[id] == kNone);
-                piece.is_free.push_back(!is_end && (params_.global || region.contains(p)) ? 1
-                                                                                           : 0);
+                piece.is_free.push_back(!is_end && (params_.global || region.contains(p)) ? 1 : 0);
                 slot_run_[run.layer][id] = static_cast<std::uint32_t>(r);
                 slot_index_[run.layer][id] = static_cast<std::uint32_t>(k);
             }
@@ -857,8 +755,8 @@ class Driver {
                 if (!nesting_kept(run.layer, run.ids, ov)) return false;
             return true;
         };
-        job.result = detail::run_engine(*job.work, job.pieces, params_.untangling,
-                                        job.relations, job.settings, is_ok, {});
+        job.result = detail::run_engine(*job.work, job.pieces, params_.untangling, job.relations,
+                                        job.settings, is_ok, {});
     }
 
     // The box of the job's vertices before and after, and of the removed vertex.
@@ -1027,7 +925,7 @@ class Driver {
             report_.seconds_fields += job.result.seconds_fields;  // the first run's time
             report_.seconds_untangle += job.result.seconds_untangle;
             report_.seconds_finish += job.result.seconds_finish;
-        report_.seconds_finish += job.result.seconds_finish;
+            report_.seconds_finish += job.result.seconds_finish;
             report_.seconds_check += job.result.seconds_check + job.seconds_prepare;
             ++report_.batch_reruns;
             conclude(job.l, job.v, untangle_now(job.l, job.v));
@@ -1048,7 +946,7 @@ class Driver {
     std::vector<std::vector<std::uint32_t>> mark_;  // a job's runs: the job's stamp
     std::uint32_t mark_counter_ = 0;
     std::vector<std::vector<std::uint32_t>> slot_run_, slot_index_;  // where in its job's runs
-    bool conflict_ = false;  // prepare() met a waiting job
+    bool conflict_ = false;                                          // prepare() met a waiting job
     double max_reach_ = 0.0;  // largest separation needed between two layers
     struct Touched {
         Box2 box;                     // a removal made while jobs waited
@@ -1073,8 +971,7 @@ void validate(const SimplifyParams& params) {
     if (!(params.max_error >= 0.0) || !std::isfinite(params.max_error))
         throw InvalidInput("simplify: params.max_error must be >= 0 and finite (got " +
                            format_number(params.max_error) + ")");
-    if (params.batch < 1)
-        throw InvalidInput("simplify: params.batch must be >= 1 (got 0)");
+    if (params.batch < 1) throw InvalidInput("simplify: params.batch must be >= 1 (got 0)");
     make_decimator(params.decimator, params.seed);
     validate(params.untangling);
 }

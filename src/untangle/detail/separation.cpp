@@ -235,6 +235,7 @@ class Finisher {
         measure(result, changed);
         if (wrong_side_ > wrong_before || (wrong_side_ == wrong_before && worst_ > worst_before)) {
             pts_ = before;
+            result.moves = 0;
             result.worst = worst_before;
             result.wrong_side = wrong_before;
             result.reverted = true;

@@ -44,7 +44,7 @@ struct SeparationParams {
 /// What finish_separations() did.
 struct SeparationResult {
     int sweeps = 0;
-    std::size_t moves = 0;       ///< Vertex moves made (each validated).
+    std::size_t moves = 0;       ///< Vertex moves made and kept (each validated).
     std::size_t refused = 0;     ///< Moves refused because they would have tunnelled.
     std::size_t wrong_side = 0;  ///< Close vertices on the wrong side at the last sweep.
     double worst = 0.0;  ///< Largest remaining shortfall, as a fraction of the aim (0: none).
