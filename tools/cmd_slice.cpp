@@ -12,10 +12,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,8 @@ struct SliceOptions {
     std::vector<std::string> order;
     std::string output;
     std::string prefix;
+    std::string thickness;
+    bool no_weld = false;
     SliceParams params;
 };
 
@@ -60,6 +64,20 @@ void note_read(const std::string& path, const MeshReadReport& r) {
     if (r.degenerate_triangles > 0)
         std::cerr << "strata: note: " << path << ": " << r.degenerate_triangles
                   << " degenerate triangles (repeated vertex) removed\n";
+}
+
+// A finite length >= 0 written in full (no trailing characters).
+double parse_length(const std::string& text, const std::string& what) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v) || v < 0.0)
+        throw InvalidInput("slice: " + what + " must be a finite length >= 0 (got '" + text + "')");
+    return v;
 }
 
 }  // namespace
@@ -92,9 +110,17 @@ Run add_slice_command(CLI::App& app) {
     cmd->add_option("--coverage", opt->params.nesting.coverage,
                     "Share of a layer within the nesting distance of another to run alongside it")
         ->default_str(format_number(defaults.nesting.coverage));
-    cmd->add_option("--thickness", opt->params.thickness,
-                    "Thickness written to every layer (mesh units)")
+    cmd->add_option("--thickness", opt->thickness,
+                    "Thickness written to the layers (mesh units): T for every mesh, or per mesh "
+                    "NAME=T,NAME=T (e.g. body=0,suit=0.002; unnamed meshes get 0)")
         ->default_str(format_number(defaults.thickness));
+    cmd->add_flag("--no-weld", opt->no_weld,
+                  "Keep every open piece its own layer (default: join pieces whose ends meet or "
+                  "overlap at a seam)");
+    cmd->add_option("--weld-tolerance", opt->params.weld.tolerance,
+                    "Join open ends at most this far apart (mesh units; 0 = " +
+                        format_number(kAutoWeldFraction) + " x the median edge length)")
+        ->default_str(format_number(defaults.weld.tolerance));
     cmd->add_option("--units", opt->params.units, "Length unit written to the scenes (e.g. dm, m)");
     cmd->add_option("--prefix", opt->prefix,
                     "File name prefix in a folder output (default: the mesh names joined by '+')");
@@ -106,7 +132,24 @@ Run add_slice_command(CLI::App& app) {
         SliceParams params = opt->params;
         params.axis = parse_axis(opt->axis);
         params.order = opt->order;
+        params.weld.enabled = !opt->no_weld;
+        params.thickness = 0.0;
+        if (!opt->thickness.empty()) {
+            if (opt->thickness.find('=') == std::string::npos) {
+                params.thickness = parse_length(opt->thickness, "--thickness");
+            } else {
+                std::stringstream items(opt->thickness);
+                for (std::string item; std::getline(items, item, ',');) {
+                    const std::size_t eq = item.find('=');
+                    if (eq == std::string::npos || eq == 0)
+                        throw InvalidInput("slice: --thickness item '" + item + "' is not NAME=T");
+                    params.mesh_thickness[item.substr(0, eq)] =
+                        parse_length(item.substr(eq + 1), "--thickness " + item.substr(0, eq));
+                }
+            }
+        }
         validate(params.nesting);
+        validate(params.weld);
 
         std::vector<SliceMesh> meshes;
         std::vector<std::filesystem::path> inputs;
@@ -181,6 +224,16 @@ Run add_slice_command(CLI::App& app) {
                 s.vertices, s.nesting.links, check.crossing_count, check.touch_count,
                 check.total_self_crossings(), check.nesting_violation_count,
                 crosses ? " [input already crosses]" : "", misses.c_str(), out.string().c_str());
+            if (!s.welded.empty()) {
+                std::string welds;
+                for (const WeldedLayer& w : s.welded)
+                    welds += (welds.empty() ? "" : ", ") + w.name + " (" +
+                             std::to_string(w.pieces) + (w.pieces == 1 ? " piece" : " pieces") +
+                             (w.overlaps > 0 ? ", " + std::to_string(w.overlaps) + " overlapping"
+                                             : std::string()) +
+                             (w.closed ? ", closed" : ", open") + ")";
+                std::printf("  welded: %s\n", welds.c_str());
+            }
         }
         std::printf("%zu of %zu slices written, %zu already crossing\n", written,
                     report.slices.size(), crossing);

@@ -3,6 +3,7 @@
 
 #include "strata/core/error.h"
 #include "strata/core/format.h"
+#include "strata/geometry/predicates.h"
 
 // GCC 12 at -O3 reports a false -Wmaybe-uninitialized inside OpenMesh's property containers
 // (std::vector<VectorT>::push_back of a default-constructed value), at instantiations that are
@@ -30,6 +31,7 @@
 #include <map>
 #include <mutex>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -771,6 +773,216 @@ MeshSection section_mesh(const SliceMesh& mesh, Axis axis, double height) {
 }
 
 // -------------------------------------------------------------------------------------------------
+// Welding the open pieces of one mesh at its seams.
+
+void validate(const WeldParams& params) {
+    if (!(std::isfinite(params.tolerance) && params.tolerance >= 0.0))
+        throw InvalidInput("weld: params.tolerance must be finite and >= 0 (got " +
+                           format_number(params.tolerance) + ")");
+    if (params.overlap_segments < 0)
+        throw InvalidInput("weld: params.overlap_segments must be >= 0 (got " +
+                           std::to_string(params.overlap_segments) + ")");
+}
+
+double median_edge_length(const SliceMesh& mesh) {
+    std::vector<double> lengths;
+    lengths.reserve(mesh.triangles.size() * 3);
+    for (const auto& t : mesh.triangles)
+        for (std::size_t k = 0; k < 3; ++k)
+            lengths.push_back(glm::distance(mesh.vertices[t[k]], mesh.vertices[t[(k + 1) % 3]]));
+    if (lengths.empty()) return 0.0;
+    auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), mid, lengths.end());
+    return *mid;
+}
+
+namespace {
+
+// End `side` (0 front, 1 back) of an open piece; segment k counted from that end.
+struct WeldEnd {
+    std::size_t piece = 0;
+    int side = 0;
+};
+
+std::pair<Vec2, Vec2> end_segment(const std::vector<Vec2>& p, int side, std::size_t k) {
+    if (side == 0) return {p[k], p[k + 1]};
+    return {p[p.size() - 1 - k], p[p.size() - 2 - k]};
+}
+
+struct WeldCandidate {
+    int kind = 0;  // 0: the ends meet, 1: they overlap (cut at the crossing)
+    double cost = 0.0;
+    WeldEnd a, b;
+    std::size_t ka = 0, kb = 0;  // overlap: crossing segments, counted from each end
+    Vec2 at{};                   // overlap: the crossing point
+};
+
+}  // namespace
+
+WeldReport weld_section(MeshSection& section, double mesh_edge, const WeldParams& params) {
+    validate(params);
+    WeldReport report;
+    report.tolerance = params.tolerance > 0.0 ? params.tolerance : kAutoWeldFraction * mesh_edge;
+    if (!params.enabled) return report;
+    std::vector<std::size_t> open;
+    for (std::size_t i = 0; i < section.pieces.size(); ++i)
+        if (!section.pieces[i].closed) open.push_back(i);
+    if (open.empty()) return report;
+    const double tol = report.tolerance;
+    const auto window = static_cast<std::size_t>(params.overlap_segments);
+    auto pts = [&](const WeldEnd& e) -> const std::vector<Vec2>& {
+        return section.pieces[open[e.piece]].points;
+    };
+    auto point = [&](const WeldEnd& e) { return e.side == 0 ? pts(e).front() : pts(e).back(); };
+
+    std::vector<WeldEnd> ends;
+    for (std::size_t i = 0; i < open.size(); ++i)
+        for (int side = 0; side < 2; ++side) ends.push_back({i, side});
+    std::vector<WeldCandidate> candidates;
+    for (std::size_t i = 0; i < ends.size(); ++i)
+        for (std::size_t j = i + 1; j < ends.size(); ++j) {
+            const WeldEnd &a = ends[i], &b = ends[j];
+            const bool same = a.piece == b.piece;
+            const std::size_t segs = pts(a).size() - 1;
+            if (same && segs < 2) continue;  // a loop needs 3 points
+            const double d = glm::distance(point(a), point(b));
+            if (d <= tol) {
+                candidates.push_back({0, d, a, b, 0, 0, {}});
+                continue;
+            }
+            // Overlap: look for a proper crossing among the end windows, nearest the ends.
+            const std::size_t wa = std::min(window, pts(a).size() - 1),
+                              wb = std::min(window, pts(b).size() - 1);
+            if (same && segs < wa + wb + 1) continue;  // the windows must not share a segment
+            bool found = false;
+            for (std::size_t sum = 0; sum + 1 < wa + wb && !found; ++sum)
+                for (std::size_t ka = 0; ka <= sum && !found; ++ka) {
+                    const std::size_t kb = sum - ka;
+                    if (ka >= wa || kb >= wb) continue;
+                    const auto [p0, p1] = end_segment(pts(a), a.side, ka);
+                    const auto [q0, q1] = end_segment(pts(b), b.side, kb);
+                    if (segment_contact(p0, p1, q0, q1) != SegmentContact::Proper) continue;
+                    candidates.push_back({1, static_cast<double>(sum), a, b, ka, kb,
+                                          crossing_point(p0, p1, q0, q1)});
+                    found = true;
+                }
+        }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const WeldCandidate& x, const WeldCandidate& y) {
+                         return std::tie(x.kind, x.cost) < std::tie(y.kind, y.cost);
+                     });
+    // partner[piece * 2 + side] = the end it is joined to.
+    constexpr std::size_t kFree = std::numeric_limits<std::size_t>::max();
+    std::vector<std::size_t> partner(open.size() * 2, kFree);
+    std::vector<char> is_overlap(open.size() * 2, 0);
+    struct Cut {
+        std::size_t k;
+        Vec2 at;
+    };
+    std::vector<std::optional<Cut>> cut(open.size() * 2);
+    for (const WeldCandidate& c : candidates) {
+        const std::size_t ea = c.a.piece * 2 + static_cast<std::size_t>(c.a.side),
+                          eb = c.b.piece * 2 + static_cast<std::size_t>(c.b.side);
+        if (partner[ea] != kFree || partner[eb] != kFree) continue;
+        if (c.kind == 1) {
+            // Both ends of one piece cut: the cuts must leave a segment between them.
+            const std::size_t oa = c.a.piece * 2 + 1 - static_cast<std::size_t>(c.a.side),
+                              ob = c.b.piece * 2 + 1 - static_cast<std::size_t>(c.b.side);
+            const std::size_t na = pts(c.a).size() - 1, nb = pts(c.b).size() - 1;
+            if (cut[oa] && cut[oa]->k + c.ka + 2 > na) continue;
+            if (cut[ob] && cut[ob]->k + c.kb + 2 > nb) continue;
+            cut[ea] = Cut{c.ka, c.at};
+            cut[eb] = Cut{c.kb, c.at};
+            is_overlap[ea] = is_overlap[eb] = 1;
+            ++report.overlaps;
+        }
+        partner[ea] = eb;
+        partner[eb] = ea;
+        ++report.joins;
+    }
+    if (report.joins == 0) return report;
+
+    // Cut the overlapping ends at their crossing (back first: the front cut shifts indices).
+    for (std::size_t i = 0; i < open.size(); ++i) {
+        std::vector<Vec2>& p = section.pieces[open[i]].points;
+        if (const auto& back = cut[i * 2 + 1]) {
+            p.resize(p.size() - 1 - back->k);
+            p.push_back(back->at);
+        }
+        if (const auto& front = cut[i * 2]) {
+            p.erase(p.begin(), p.begin() + static_cast<std::ptrdiff_t>(front->k + 1));
+            p.insert(p.begin(), front->at);
+        }
+    }
+
+    // Chain: from every free end first (open chains), then around the remaining cycles.
+    std::vector<char> used(open.size(), 0);
+    std::vector<SectionPiece> chained;
+    auto append = [](std::vector<Vec2>& out, const std::vector<Vec2>& p, bool reversed) {
+        std::vector<Vec2> q = p;
+        if (reversed) std::reverse(q.begin(), q.end());
+        if (!out.empty()) {
+            // The junction: both ends become their midpoint.
+            out.back() = 0.5 * (out.back() + q.front());
+            out.insert(out.end(), q.begin() + 1, q.end());
+        } else {
+            out = std::move(q);
+        }
+    };
+    auto walk = [&](std::size_t start_piece, int start_side) {
+        SectionPiece piece;
+        piece.component = section.pieces[open[start_piece]].component;
+        std::set<std::uint32_t> components;
+        std::size_t at = start_piece * 2 + static_cast<std::size_t>(start_side), count = 0,
+                    overlaps = 0;
+        for (;;) {
+            const std::size_t i = at / 2;
+            used[i] = 1;
+            ++count;
+            components.insert(section.pieces[open[i]].component);
+            append(piece.points, section.pieces[open[i]].points, at % 2 == 1);
+            const std::size_t exit = i * 2 + 1 - at % 2;
+            const std::size_t next = partner[exit];
+            if (next == kFree) break;
+            if (is_overlap[exit]) ++overlaps;
+            if (next / 2 == start_piece && next % 2 == static_cast<std::size_t>(start_side)) {
+                piece.closed = true;
+                piece.points.front() = 0.5 * (piece.points.front() + piece.points.back());
+                piece.points.pop_back();
+                break;
+            }
+            at = next;
+        }
+        std::vector<Vec2>& p = piece.points;
+        p.erase(std::unique(p.begin(), p.end()), p.end());
+        while (piece.closed && p.size() >= 2 && p.back() == p.front()) p.pop_back();
+        if (piece.closed && p.size() < 3) piece.closed = false;
+        if (count > 1 || piece.closed) {
+            piece.welded_components.assign(components.begin(), components.end());
+            piece.welded_pieces = count;
+            piece.welded_overlaps = overlaps;
+            if (piece.closed) ++report.closed;
+        }
+        if (p.size() >= 2)
+            chained.push_back(std::move(piece));
+        else
+            ++section.dropped_pieces;
+    };
+    for (std::size_t i = 0; i < open.size(); ++i)
+        for (int side = 0; side < 2; ++side)
+            if (!used[i] && partner[i * 2 + static_cast<std::size_t>(side)] == kFree) walk(i, side);
+    for (std::size_t i = 0; i < open.size(); ++i)
+        if (!used[i]) walk(i, 0);
+
+    std::vector<SectionPiece> pieces;
+    for (SectionPiece& p : section.pieces)
+        if (p.closed) pieces.push_back(std::move(p));
+    for (SectionPiece& p : chained) pieces.push_back(std::move(p));
+    section.pieces = std::move(pieces);
+    return report;
+}
+
+// -------------------------------------------------------------------------------------------------
 // Nesting.
 
 void validate(const NestingParams& params) {
@@ -940,7 +1152,12 @@ void validate(const SliceParams& params) {
     if (!(std::isfinite(params.thickness) && params.thickness >= 0.0))
         throw InvalidInput("slice: params.thickness must be finite and >= 0 (got " +
                            format_number(params.thickness) + ")");
+    for (const auto& [name, t] : params.mesh_thickness)
+        if (!(std::isfinite(t) && t >= 0.0))
+            throw InvalidInput("slice: params.mesh_thickness['" + name +
+                               "'] must be finite and >= 0 (got " + format_number(t) + ")");
     validate(params.nesting);
+    validate(params.weld);
 }
 
 SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams& params,
@@ -967,6 +1184,14 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
     }
     for (std::size_t m = 0; m < meshes.size(); ++m)
         if (mesh_rank[m] < 0) sequence.push_back(m);
+    for (const auto& [name, t] : params.mesh_thickness)
+        if (by_name.count(name) == 0)
+            throw InvalidInput("slice: params.mesh_thickness names '" + name +
+                               "', which is not a mesh");
+    std::vector<double> mesh_edge(meshes.size(), 0.0);
+    if (params.weld.enabled && params.weld.tolerance == 0.0)
+        for (std::size_t m = 0; m < meshes.size(); ++m)
+            mesh_edge[m] = median_edge_length(meshes[m]);
 
     SliceReport report;
     const auto names = plane_coordinate_names(params.axis);
@@ -981,6 +1206,7 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
         for (std::size_t m : sequence) {
             const SliceMesh& mesh = meshes[m];
             MeshSection section = section_mesh(mesh, params.axis, slice.height);
+            weld_section(section, mesh_edge[m], params.weld);
             slice.totals.crossed_triangles += section.crossed_triangles;
             slice.totals.branch_points += section.branch_points;
             slice.totals.merged_points += section.merged_points;
@@ -989,29 +1215,46 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
                 slice.missed_meshes.push_back(mesh.name);
                 continue;
             }
-            // Group by component (or not), longest piece first within a group.
-            std::map<std::uint32_t, std::vector<Layer>> groups;
+            // Group by component(s) (or not), longest piece first within a group.
+            const auto t = params.mesh_thickness.find(mesh.name);
+            const double thickness =
+                t != params.mesh_thickness.end() ? t->second : params.thickness;
+            std::map<std::vector<std::uint32_t>, std::vector<std::pair<Layer, WeldedLayer>>> groups;
             for (SectionPiece& piece : section.pieces) {
                 Layer layer;
                 layer.closed = piece.closed;
                 layer.points = std::move(piece.points);
                 if (layer.closed && signed_area(layer.points) < 0.0)
                     std::reverse(layer.points.begin(), layer.points.end());
-                layer.thickness = params.thickness;
-                groups[params.split_components ? piece.component : 0u].push_back(std::move(layer));
+                layer.thickness = thickness;
+                std::vector<std::uint32_t> key;
+                if (params.split_components)
+                    key = piece.welded_components.empty()
+                              ? std::vector<std::uint32_t>{piece.component}
+                              : piece.welded_components;
+                const WeldedLayer weld{{},
+                                       piece.welded_components.empty() ? 0 : piece.welded_pieces,
+                                       piece.welded_overlaps,
+                                       layer.closed};
+                groups[key].emplace_back(std::move(layer), weld);
             }
-            for (auto& [component, group] : groups) {
-                std::stable_sort(group.begin(), group.end(), [](const Layer& a, const Layer& b) {
-                    return a.length() > b.length();
+            for (auto& [components, group] : groups) {
+                std::stable_sort(group.begin(), group.end(), [](const auto& a, const auto& b) {
+                    return a.first.length() > b.first.length();
                 });
-                const std::string base = params.split_components
-                                             ? mesh.name + ".c" + std::to_string(component)
-                                             : mesh.name;
+                std::string base = mesh.name;
+                for (std::size_t k = 0; k < components.size(); ++k)
+                    base += (k == 0 ? ".c" : "+c") + std::to_string(components[k]);
                 for (std::size_t j = 0; j < group.size(); ++j) {
-                    group[j].name = base + "_" + std::to_string(j + 1);
-                    (group[j].closed ? slice.closed_layers : slice.open_layers) += 1;
-                    slice.vertices += group[j].points.size();
-                    layers.push_back(std::move(group[j]));
+                    Layer& layer = group[j].first;
+                    layer.name = base + "_" + std::to_string(j + 1);
+                    (layer.closed ? slice.closed_layers : slice.open_layers) += 1;
+                    slice.vertices += layer.points.size();
+                    if (group[j].second.pieces > 0) {
+                        group[j].second.name = layer.name;
+                        slice.welded.push_back(group[j].second);
+                    }
+                    layers.push_back(std::move(layer));
                     rank.push_back(params.order.empty() ? -1 : mesh_rank[m]);
                 }
             }

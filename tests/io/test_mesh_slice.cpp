@@ -426,6 +426,167 @@ TEST_CASE("nesting: open half-cylinders over a closed one, stacked, or end to en
     }
 }
 
+namespace {
+
+// Panels of a tube around the y axis (radius 1, rings at y = -1 and 1), each its own
+// component: panel k spans angles [a_k - overhang, a_k + sweep + overhang].
+SliceReport slice_panels(const std::vector<std::pair<double, double>>& spans, double y,
+                         const WeldParams& weld = {}, double radius_step = 0.0) {
+    Mesh m;
+    double r = 1.0;
+    for (const auto& [a0, sweep] : spans) {
+        m.append(cylinder(0.0, 0.0, r, 8, {-1.0, 1.0}, false, a0, sweep));
+        r += radius_step;
+    }
+    SliceParams params;
+    params.heights = {y};
+    params.split_components = true;
+    params.weld = weld;
+    return slice_meshes({make_slice_mesh("tube", m.v, m.f)}, params);
+}
+
+}  // namespace
+
+TEST_CASE("welding: two panels sharing a seam become one closed layer", "[mesh_slice][weld]") {
+    const SliceMesh two = make_slice_mesh("tube", {}, {});
+    CHECK(median_edge_length(two) == 0.0);
+    const auto spans = std::vector<std::pair<double, double>>{{0.0, kPi}, {kPi, kPi}};
+    const SliceReport r = slice_panels(spans, 0.3);
+    REQUIRE(r.slices[0].scene);
+    const Scene& s = *r.slices[0].scene;
+    REQUIRE(s.size() == 1);
+    CHECK(s.layer(0).name == "tube.c0+c1_1");
+    CHECK(s.layer(0).closed);
+    CHECK(std::abs(area(s.layer(0).points) - regular_polygon_area(16, 1.0)) < 1e-9);
+    REQUIRE(r.slices[0].welded.size() == 1);
+    CHECK(r.slices[0].welded[0].name == "tube.c0+c1_1");
+    CHECK(r.slices[0].welded[0].pieces == 2);
+    CHECK(r.slices[0].welded[0].overlaps == 0);
+    CHECK(r.slices[0].welded[0].closed);
+    const CheckReport c = check_scene(s);
+    CHECK(c.crossing_count == 0);
+    CHECK(c.total_self_crossings() == 0);
+
+    WeldParams off;
+    off.enabled = false;
+    const SliceReport apart = slice_panels(spans, 0.3, off);
+    REQUIRE(apart.slices[0].scene);
+    CHECK(apart.slices[0].scene->size() == 2);
+    CHECK(apart.slices[0].scene->find("tube.c0_1"));
+    CHECK(apart.slices[0].scene->find("tube.c1_1"));
+    CHECK_FALSE(apart.slices[0].scene->layer(0).closed);
+    CHECK(apart.slices[0].welded.empty());
+    // The two seam points are shared: two points fewer than the panels had.
+    CHECK(s.layer(0).points.size() + 2 == apart.slices[0].scene->vertex_count());
+}
+
+TEST_CASE("welding: a tube cut into three panels closes, any order of the pieces",
+          "[mesh_slice][weld]") {
+    const double third = 2.0 * kPi / 3.0;
+    // Panels listed out of order around the tube, so the chain is found across the list.
+    const SliceReport r = slice_panels({{2.0 * third, third}, {0.0, third}, {third, third}}, -0.5);
+    REQUIRE(r.slices[0].scene);
+    const Scene& s = *r.slices[0].scene;
+    REQUIRE(s.size() == 1);
+    CHECK(s.layer(0).closed);
+    CHECK(s.layer(0).name == "tube.c0+c1+c2_1");
+    CHECK(std::abs(area(s.layer(0).points) - regular_polygon_area(24, 1.0)) < 1e-9);
+    REQUIRE(r.slices[0].welded.size() == 1);
+    CHECK(r.slices[0].welded[0].pieces == 3);
+    WeldParams off;
+    off.enabled = false;
+    const SliceReport apart =
+        slice_panels({{2.0 * third, third}, {0.0, third}, {third, third}}, -0.5, off);
+    REQUIRE(apart.slices[0].scene);
+    CHECK(apart.slices[0].scene->size() == 3);
+    CHECK(s.layer(0).points.size() + 3 == apart.slices[0].scene->vertex_count());
+    CHECK(check_scene(s).total_self_crossings() == 0);
+}
+
+TEST_CASE("welding: overlapping ends are cut at their crossing and joined", "[mesh_slice][weld]") {
+    // Each panel reaches 0.15 rad past both seams (ends 0.3 apart, above the automatic
+    // tolerance of about 0.1): the end chords cross the other panel's.
+    const double o = 0.15;
+    const auto spans =
+        std::vector<std::pair<double, double>>{{-o, kPi + 2 * o}, {kPi - o, kPi + 2 * o}};
+    WeldParams off;
+    off.enabled = false;
+    const SliceReport apart = slice_panels(spans, 0.0, off);
+    REQUIRE(apart.slices[0].scene);
+    CHECK(check_scene(*apart.slices[0].scene).crossing_count == 2);  // the overlap crosses
+
+    const SliceReport r = slice_panels(spans, 0.0);
+    REQUIRE(r.slices[0].scene);
+    const Scene& s = *r.slices[0].scene;
+    REQUIRE(s.size() == 1);
+    CHECK(s.layer(0).closed);
+    REQUIRE(r.slices[0].welded.size() == 1);
+    CHECK(r.slices[0].welded[0].overlaps == 2);
+    const CheckReport c = check_scene(s);
+    CHECK(c.total_self_crossings() == 0);
+    // Cut at the crossings: the loop lies within the unit circle and close to it in area.
+    for (const Vec2& p : s.layer(0).points) CHECK(glm::length(p) <= 1.0 + 1e-12);
+    CHECK(std::abs(area(s.layer(0).points) - kPi) < 0.2);
+
+    WeldParams no_overlap;
+    no_overlap.overlap_segments = 0;
+    const SliceReport kept = slice_panels(spans, 0.0, no_overlap);
+    REQUIRE(kept.slices[0].scene);
+    CHECK(kept.slices[0].scene->size() == 2);
+}
+
+TEST_CASE("welding: ends far apart stay apart; the tolerance is overridable",
+          "[mesh_slice][weld]") {
+    // Two panels with a 0.2 rad slit at each seam: 0.2 apart, edges are ~0.37 and 2 long, so
+    // the automatic tolerance (5% of the median edge) is far below the slit.
+    const auto spans =
+        std::vector<std::pair<double, double>>{{0.1, kPi - 0.2}, {kPi + 0.1, kPi - 0.2}};
+    const SliceReport r = slice_panels(spans, 0.0);
+    REQUIRE(r.slices[0].scene);
+    CHECK(r.slices[0].scene->size() == 2);
+    CHECK(r.slices[0].welded.empty());
+
+    WeldParams wide;
+    wide.tolerance = 0.25;
+    const SliceReport joined = slice_panels(spans, 0.0, wide);
+    REQUIRE(joined.slices[0].scene);
+    REQUIRE(joined.slices[0].scene->size() == 1);
+    CHECK(joined.slices[0].scene->layer(0).closed);
+
+    // Panels of different radii (1 and 1.5) do not meet either: side by side, not welded.
+    const SliceReport nested = slice_panels({{0.0, kPi}, {kPi, kPi}}, 0.0, WeldParams{}, 0.5);
+    REQUIRE(nested.slices[0].scene);
+    CHECK(nested.slices[0].scene->size() == 2);
+
+    WeldParams bad;
+    bad.tolerance = -1.0;
+    CHECK_THROWS_AS(validate(bad), InvalidInput);
+    bad = WeldParams{};
+    bad.overlap_segments = -1;
+    CHECK_THROWS_AS(validate(bad), InvalidInput);
+}
+
+TEST_CASE("thickness per mesh", "[mesh_slice]") {
+    Mesh m = cylinder(0.0, 0.0, 1.0, 8, {-1.0, 1.0}, false);
+    SliceParams params;
+    params.heights = {0.0};
+    params.thickness = 0.5;
+    params.mesh_thickness = {{"suit", 0.002}};
+    const SliceReport r =
+        slice_meshes({make_slice_mesh("body", m.v, m.f),
+                      make_slice_mesh("suit", cylinder(0.0, 0.0, 1.1, 8, {-1.0, 1.0}, false).v,
+                                      cylinder(0.0, 0.0, 1.1, 8, {-1.0, 1.0}, false).f)},
+                     params);
+    REQUIRE(r.slices[0].scene);
+    CHECK(r.slices[0].scene->layer(*r.slices[0].scene->find("body_1")).thickness == 0.5);
+    CHECK(r.slices[0].scene->layer(*r.slices[0].scene->find("suit_1")).thickness == 0.002);
+    params.mesh_thickness = {{"shirt", 0.002}};
+    CHECK_THROWS_WITH(slice_meshes({make_slice_mesh("body", m.v, m.f)}, params),
+                      Contains("'shirt'"));
+    params.mesh_thickness = {{"body", -1.0}};
+    CHECK_THROWS_AS(validate(params), InvalidInput);
+}
+
 TEST_CASE("a plane that misses every mesh gives no scene", "[mesh_slice]") {
     SliceParams params;
     params.heights = {5.0, 0.5};
@@ -470,7 +631,8 @@ TEST_CASE("real garments: every slice valid, no crossings away from known height
     // 24/28) these heights reproduce.
     const std::vector<Outfit> outfits = {
         {"male_casualsuit03", {1.0, 3.0}},
-        {"male_casualsuit05", {1.0, 2.5, 5.0, 5.5, 6.0, 6.5}},
+        // y = 5: two lapel pieces overlap at their ends; welded into one, they no longer cross.
+        {"male_casualsuit05", {1.0, 2.5, 5.5, 6.0, 6.5}},
         {"male_elegantsuit01", {1.0, 2.5, 4.5, 5.0}},
     };
     SliceParams params;
@@ -500,6 +662,27 @@ TEST_CASE("real garments: the Codim-IPC skirt by components", "[mesh_slice][slow
     SliceParams params;
     params.split_components = true;
     params.heights = {0.0, -0.15, -0.3};
+    {
+        // Welded (the default): each tier's front and back panels make one closed loop.
+        const SliceReport r = slice_meshes({skirt}, params);
+        for (const PlaneSlice& s : r.slices) {
+            INFO("y = " << s.height);
+            REQUIRE(s.scene);
+            for (const char* tier : {"skirt.c1+c2_1", "skirt.c3+c4_1", "skirt.c5+c6_1"}) {
+                INFO(tier);
+                REQUIRE(s.scene->find(tier));
+                CHECK(s.scene->layer(*s.scene->find(tier)).closed);
+            }
+            CHECK(outer_of(*s.scene, "skirt.c1+c2_1") == Names{"skirt.c3+c4_1"});
+            CHECK(outer_of(*s.scene, "skirt.c3+c4_1") == Names{"skirt.c5+c6_1"});
+            CHECK(s.open_layers == 0);
+            const CheckReport c = check_scene(*s.scene);
+            CHECK(c.crossing_count == 0);
+            CHECK(c.total_self_crossings() == 0);
+            CHECK(c.nesting_violation_count == 0);
+        }
+    }
+    params.weld.enabled = false;
     const SliceReport r = slice_meshes({skirt}, params);
     // Front / back panels of one tier (numbered as in SOURCES.md) overlap at the side seams.
     const std::set<std::pair<std::string, std::string>> partners = {{"skirt.c1_1", "skirt.c2_1"},
@@ -509,6 +692,7 @@ TEST_CASE("real garments: the Codim-IPC skirt by components", "[mesh_slice][slow
     for (const PlaneSlice& s : r.slices) {
         INFO("y = " << s.height);
         REQUIRE(s.scene);
+        CHECK(s.welded.empty());
         CHECK(s.scene->find("skirt.c0_1"));  // the legs: two closed loops
         CHECK(s.scene->find("skirt.c0_2"));
         CHECK(s.scene->layer(*s.scene->find("skirt.c0_1")).closed);

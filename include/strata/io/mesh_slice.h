@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -94,6 +95,11 @@ struct SectionPiece {
                                   ///< consecutive points equal (closed: first != last either).
     bool closed = false;          ///< A loop; otherwise it ends at mesh borders.
     std::uint32_t component = 0;  ///< SliceMesh::component of its triangles.
+    /// Components of every piece weld_section() joined into this one, increasing (empty: not
+    /// welded; `component` is then the only one, else the first of the chain).
+    std::vector<std::uint32_t> welded_components;
+    std::size_t welded_pieces = 1;    ///< Pieces of section_mesh() chained into this one.
+    std::size_t welded_overlaps = 0;  ///< Of its joins, those made at overlapping ends.
 };
 
 /// The intersection of a mesh with one plane.
@@ -118,6 +124,46 @@ struct MeshSection {
 /// vertex lies on the plane is that vertex exactly. Coincident consecutive points (from such
 /// vertices and from degenerate slivers) are merged, so no piece has a zero-length segment.
 MeshSection section_mesh(const SliceMesh& mesh, Axis axis, double height);
+
+/// Parameters of weld_section(): joining the open pieces of one mesh that meet at a seam.
+struct WeldParams {
+    bool enabled = true;  ///< false: every open piece stays its own layer (`--no-weld`).
+    /// Ends of two open pieces (or the two ends of one) at most this far apart are joined, at
+    /// their midpoint. Mesh units, >= 0; 0 = automatic: kAutoWeldFraction of the median
+    /// triangle edge length of the mesh (median_edge_length()).
+    double tolerance = 0.0;
+    /// Overlapping ends: when a segment among the last `overlap_segments` of one end crosses
+    /// a segment among the last `overlap_segments` of another end, both are cut at the
+    /// crossing and joined there. >= 0; 0 = only ends that meet are welded.
+    int overlap_segments = 3;
+};
+
+/// The automatic weld tolerance as a share of the median triangle edge length. Panels of a
+/// sewn garment meet to within float rounding (1e-7 m against 5e-3 m edges on the Codim-IPC
+/// skirt), while ends that belong apart (a collar's tips, a slit) are edges apart.
+constexpr double kAutoWeldFraction = 0.05;
+
+/// Throws InvalidInput naming the first out-of-range field.
+void validate(const WeldParams& params);
+
+/// Median length of the triangle edges of `mesh` (mesh units); 0 for a mesh without triangles.
+double median_edge_length(const SliceMesh& mesh);
+
+/// What weld_section() joined.
+struct WeldReport {
+    double tolerance = 0.0;    ///< Tolerance actually used, mesh units.
+    std::size_t joins = 0;     ///< Pairs of ends joined (meeting or overlapping).
+    std::size_t overlaps = 0;  ///< Of these, joins at overlapping ends (cut at the crossing).
+    std::size_t closed = 0;    ///< Chains of open pieces that closed into a loop.
+};
+
+/// @brief Joins the open pieces of `section` (all from one mesh) whose ends meet within
+/// `params.tolerance` or overlap near their ends (see WeldParams) into longer polylines, closed
+/// when a chain closes. Joins are made closest first (meeting ends before overlaps), each end
+/// at most once. Closed pieces are left alone. Nothing happens when params.enabled is false.
+/// @param mesh_edge  median edge length of the mesh, for the automatic tolerance (mesh units).
+/// @throws InvalidInput bad params.
+WeldReport weld_section(MeshSection& section, double mesh_edge, const WeldParams& params = {});
 
 /// Parameters of nest_layers(). Lengths are in scene units.
 struct NestingParams {
@@ -177,22 +223,36 @@ struct SliceParams {
     /// Every name must be a mesh name, at most once; unnamed meshes follow in given order.
     std::vector<std::string> order;
     NestingParams nesting;   ///< See nest_layers().
+    WeldParams weld;         ///< See weld_section(); on by default.
     double thickness = 0.0;  ///< Thickness written to every layer, mesh units, >= 0.
+    /// Thickness per mesh name (mesh units, >= 0), overriding `thickness` for that mesh's
+    /// layers; every name must be a mesh name.
+    std::map<std::string, double> mesh_thickness;
     std::string units;       ///< Length unit written to the scenes ("dm", "m"); may be empty.
 };
 
 /// Throws InvalidInput naming the first out-of-range field.
 void validate(const SliceParams& params);
 
+/// A layer of slice_meshes() welded from several pieces of section_mesh().
+struct WeldedLayer {
+    std::string name;          ///< Layer name in the scene.
+    std::size_t pieces = 0;    ///< Open pieces joined.
+    std::size_t overlaps = 0;  ///< Joins made at overlapping ends.
+    bool closed = false;       ///< The chain closed into a loop.
+};
+
 /// One plane of slice_meshes().
 struct PlaneSlice {
     double height = 0.0;
     /// The layers, or nothing when the plane misses every mesh. Layer j of a mesh (or of a
-    /// component) is the j-th longest of its pieces, from 1. Metadata: "plane", "coords".
+    /// component) is the j-th longest of its pieces, from 1; a piece welded from several
+    /// components is named after all of them (`skirt.c1+c2_1`). Metadata: "plane", "coords".
     std::optional<Scene> scene;
     std::size_t closed_layers = 0, open_layers = 0, vertices = 0;
     std::vector<std::string> missed_meshes;  ///< Meshes the plane does not cross.
     MeshSection totals;  ///< Counters summed over the meshes (pieces left empty).
+    std::vector<WeldedLayer> welded;  ///< Layers made of several pieces, in scene order.
     NestingReport nesting;
 };
 
