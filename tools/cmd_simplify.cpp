@@ -72,6 +72,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"batches", r.batches},
                         {"batch_reruns", r.batch_reruns},
                         {"targets_met", r.targets_met},
+                        {"raised_separations", r.raised_separations},
                         {"crossings", r.crossings},
                         {"self_crossings", r.self_crossings},
                         {"nesting_violations", r.nesting_violations},
@@ -129,6 +130,11 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
         r.min_separation_ratio, max_hausdorff(r), r.removed, r.deferred, r.untangle_calls,
         r.batches, r.refused, r.gave_up, r.seconds_total, r.seconds_decimate, r.seconds_fields,
         r.seconds_untangle, r.seconds_finish, r.seconds_check, peak_memory_mib());
+    if (r.raised_separations > 0)
+        std::printf(
+            "gap rule: %zu pairs of layers without thickness keep their share of the "
+            "input gap (--keep-gaps)\n",
+            r.raised_separations);
     if (!r.collision_free)
         std::fprintf(
             stderr,
@@ -417,6 +423,10 @@ Run add_simplify_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--thickness", opt->thickness,
                     "Thickness for layers whose thickness is 0 (scene units)");
+    cmd->add_option("--keep-gaps", p.keep_input_gaps,
+                    "Pairs of layers whose thicknesses require nothing keep this share of their "
+                    "smallest input gap (0: off)")
+        ->capture_default_str();
     cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")
         ->capture_default_str();
     cmd->add_flag("--global", p.global,

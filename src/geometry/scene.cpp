@@ -207,6 +207,19 @@ double Scene::required_separation(std::size_t a, std::size_t b) const {
     return a == b ? 0.0 : separation_.at(a).at(b);
 }
 
+void Scene::raise_required_separation(std::size_t a, std::size_t b, double value) {
+    if (a == b || a >= layers_.size() || b >= layers_.size())
+        throw InvalidInput("scene: raise_required_separation needs two distinct layers (got " +
+                           std::to_string(a) + " and " + std::to_string(b) + " of " +
+                           std::to_string(layers_.size()) + ")");
+    if (!(std::isfinite(value) && value >= 0.0))
+        throw InvalidInput("scene: raise_required_separation value must be finite and >= 0 (got " +
+                           format_number(value) + ")");
+    if (separation_[a][b] >= value) return;
+    separation_[a][b] = separation_[b][a] = value;
+    raised_.push_back({std::min(a, b), std::max(a, b), value});
+}
+
 Box2 Scene::bounds() const {
     Box2 box;
     for (const Layer& layer : layers_) box.extend(layer.bounds());

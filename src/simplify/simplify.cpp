@@ -5,6 +5,7 @@
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/input_gaps.h"
 #include "strata/geometry/predicates.h"
 #include "strata/simplify/decimator.h"
 #include "untangle/detail/engine.h"
@@ -972,15 +973,32 @@ void validate(const SimplifyParams& params) {
         throw InvalidInput("simplify: params.max_error must be >= 0 and finite (got " +
                            format_number(params.max_error) + ")");
     if (params.batch < 1) throw InvalidInput("simplify: params.batch must be >= 1 (got 0)");
+    if (!(params.keep_input_gaps >= 0.0 && params.keep_input_gaps <= 1.0))
+        throw InvalidInput("simplify: params.keep_input_gaps must be in [0, 1] (got " +
+                           format_number(params.keep_input_gaps) + ")");
     make_decimator(params.decimator, params.seed);
     validate(params.untangling);
 }
 
 SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const ProgressFn& progress) {
     validate(params);
-    Driver driver(scene, params);
+    // The gap rule raises required separations on a copy: `scene` stays unchanged on throw.
+    Scene input = scene;
+    std::size_t raised = 0;
+    if (params.untangle && params.keep_input_gaps > 0.0) {
+        InputGapParams gap_params;
+        // Gaps pass at required x (1 - separation_tolerance): ask for enough that the kept
+        // share is keep_input_gaps, at most the whole gap.
+        gap_params.fraction =
+            std::min(1.0, params.keep_input_gaps / (1.0 - params.untangling.separation_tolerance));
+        raised = keep_input_gaps(input, gap_params).raised;
+    }
+    Driver driver(input, params);
     SimplifyReport report = driver.run(progress);
+    report.raised_separations = raised;
     Scene out = driver.result();
+    for (const Scene::RaisedSeparation& r : input.raised_separations())
+        out.raise_required_separation(r.a, r.b, r.value);
 
     auto start = Clock::now();
     CheckParams check_params;

@@ -67,8 +67,21 @@ class Scene {
 
     /// Placement of layer `a` with respect to layer `b`.
     Relation relation(std::size_t a, std::size_t b) const;
-    /// Required distance between layers `a` and `b` (scene units), see the class comment.
+    /// Required distance between layers `a` and `b` (scene units), see the class comment,
+    /// raised by raise_required_separation().
     double required_separation(std::size_t a, std::size_t b) const;
+    /// A required separation raised above what the thicknesses ask (keep_input_gaps()).
+    struct RaisedSeparation {
+        std::size_t a = 0, b = 0;  ///< Layer indices, a < b.
+        double value = 0.0;        ///< Scene units.
+    };
+    /// Raises required_separation(a, b) (both orders) to at least `value`; the chains through
+    /// a and b are not recomputed. No effect when it is already >= value.
+    /// @throws InvalidInput a == b, an index out of range, or value not finite or < 0.
+    void raise_required_separation(std::size_t a, std::size_t b, double value);
+    /// Every raise_required_separation() that changed a value, in call order: what a scene
+    /// rebuilt from the same layers needs to be given again.
+    const std::vector<RaisedSeparation>& raised_separations() const { return raised_; }
 
     /// Length unit of the coordinates as given by the file ("m", "dm" ...); may be empty.
     const std::string& units() const { return units_; }
@@ -90,6 +103,7 @@ class Scene {
     std::vector<std::vector<std::size_t>> outer_, inner_;
     std::vector<std::vector<char>> under_;  // under_[a][b]: a is under b
     std::vector<std::vector<double>> separation_;
+    std::vector<RaisedSeparation> raised_;
     SceneDiagnostics diagnostics_;
 };
 

@@ -37,6 +37,14 @@ struct SimplifyParams {
     /// > 0: never remove a vertex whose removal leaves an input vertex farther than this from
     /// the simplified layer (span_error()); with `remove` = 1 this is the target itself.
     double max_error = 0.0;
+    /// Gap rule for layers without thickness (keep_input_gaps(), applied when `untangle` is
+    /// set, before the first removal): a near pair of layers whose thicknesses require no
+    /// separation keeps at least this share of its smallest gap in the input. Its required
+    /// separation becomes min(1, keep_input_gaps / (1 - untangling.separation_tolerance)) x
+    /// that gap (1.0 x the gap with the defaults), so that the untangler and the exact checks,
+    /// which pass a gap at required x (1 - separation_tolerance), keep this share. [0, 1];
+    /// 0 = off (such pairs may then come as close as the untangler's min_separation).
+    double keep_input_gaps = 0.9;
     std::uint64_t seed = 1;  ///< Seed of the random decimator.
     bool untangle = true;    ///< false: naive decimation (the paper's left-hand images).
     bool global = false;     ///< Untangle the whole scene instead of a box (for comparison).
@@ -101,6 +109,8 @@ struct SimplifyReport {
     /// Batches run; untangle_calls / batches is the mean number of jobs per batch.
     std::size_t batches = 0;
     bool targets_met = true;         ///< Every layer reached its target.
+    /// Pairs of layers whose required separation the gap rule raised (keep_input_gaps).
+    std::size_t raised_separations = 0;
     // Final exact check of the whole output (check_scene()).
     std::size_t crossings = 0, self_crossings = 0, nesting_violations = 0;
     double min_separation_ratio = 0.0;  ///< +inf when nothing is required.
