@@ -3,7 +3,8 @@
 # `strata check` on every slice, then `strata simplify` on every slice at 90% removal (a batch:
 # slices whose input already crosses are untangled first, or fail with the reason when that
 # cannot be done, e.g. a layer that crosses itself); prints one summary row per outfit for each
-# stage.
+# stage, and writes one HTML gallery per outfit (OUT_DIR/NAME.html: a tile per slice, the input
+# faint under the result, crossings ringed in red; bench/gallery.py).
 #
 #   bench/garments.sh [OUT_DIR]          (from the repository root, after building strata_cli)
 #
@@ -28,7 +29,8 @@ slice_outfit() {
   rm -rf "${out:?}/$name"
   local t0=$SECONDS
   "$strata" slice "$@" --every "$step" --prefix "$name" -o "$out/$name" > "$out/$name.slice.log" 2> "$out/$name.slice.err"
-  local slices=0 layers=0 vertices=0 crossing=0 nesting=0 links=0
+  local slices=0 layers=0 vertices=0 crossing=0 nesting=0 links=0 welded
+  welded=$(grep -c '^  welded: ' "$out/$name.slice.log" || true)
   while IFS= read -r line; do
     links=$((links + $(sed -E 's/.* ([0-9]+) nesting links.*/\1/' <<< "$line")))
   done < <(grep ' nesting links' "$out/$name.slice.log")
@@ -47,14 +49,20 @@ slice_outfit() {
       nesting=$((nesting + 1))
     fi
   done
-  rows+=("$(printf '%-20s %6d %7d %9d %7d %10d %9d %6ds' "$name" "$slices" "$layers" "$vertices" "$links" \
-            "$crossing" "$nesting" $((SECONDS - t0)))")
+  rows+=("$(printf '%-20s %6d %7d %9d %7d %7d %10d %9d %6ds' "$name" "$slices" "$layers" "$vertices" "$links" \
+            "$welded" "$crossing" "$nesting" $((SECONDS - t0)))")
   # Simplify the whole folder at 90% removal (batch, parallel over slices).
   t0=$SECONDS
   rm -rf "${out:?}/$name-simplified"
   "$strata" simplify "$out/$name" -o "$out/$name-simplified" --remove 0.9 --compare-naive \
     --report "$out/$name.simplify.json" > "$out/$name.simplify.log" 2> "$out/$name.simplify.err" || true
-  srows+=("$(python3 - "$out/$name.simplify.json" "$name" $((SECONDS - t0)) <<'PY'
+  local seconds=$((SECONDS - t0)) gaps
+  # Smallest gap after / gap before over the near pairs of every simplified slice.
+  gaps=$(python3 "$root/bench/gap_ratios.py" "$out/$name" "$out/$name-simplified" | tee "$out/$name.gaps.log" |
+         sed -nE 's/^smallest ratio ([0-9.inf]+); pairs below 0.9: ([0-9]+).*/\1 \2/p')
+  python3 "$root/bench/gallery.py" --title "$name: strata simplify --remove 0.9" --strata "$strata" \
+    --report "$out/$name.simplify.json" --out "$out/$name.html" > /dev/null
+  srows+=("$(python3 - "$out/$name.simplify.json" "$name" "$seconds" $gaps <<'PY'
 import json, sys
 runs = json.load(open(sys.argv[1]))
 ok = [r for r in runs if "error" not in r and "skipped" not in r]
@@ -68,8 +76,10 @@ tangled = sum(1 for r in ok if not r["collision_free"])
 # The guarantee: a collision-free input gives a collision-free output. Outputs of inputs that
 # were untangled first are counted apart ("after-untangle"): see the README, Real garments.
 broken = sum(1 for r in ok if not r["collision_free"] and "input_untangled" not in r)
-print("%-20s %6d %9d %6d %9d %8d %9d %8d %8d %8d %6ss %d" % (sys.argv[2], len(runs), untangled,
-      len(runs) - len(ok), before, after, naive, strata, tangled, refused, sys.argv[3], broken))
+over = sum(1 for r in ok for l in r["layers"] if l["after"] > 1.05 * l["target"] and l["after"] > 3)
+print("%-20s %6d %9d %6d %9d %8d %9d %8d %8d %8d %8d %9s %5d %6ss %d" % (sys.argv[2], len(runs), untangled,
+      len(runs) - len(ok), before, after, naive, strata, tangled, refused, over, sys.argv[4], int(sys.argv[5]),
+      sys.argv[3], broken))
 PY
 )")
 }
@@ -81,19 +91,23 @@ for suit in casualsuit03 casualsuit05 elegantsuit01; do
 done
 slice_outfit cipc_multilayer 0.05 "skirt=$data/codim-ipc/multilayer_drape.obj" --components --units m
 
-printf '%-20s %6s %7s %9s %7s %10s %9s %7s\n' outfit slices layers vertices links "crossing" "nest-viol" time
+printf '%-20s %6s %7s %9s %7s %7s %10s %9s %7s\n' outfit slices layers vertices links welded "crossing" "nest-viol" time
 for r in "${rows[@]}"; do echo "$r"; done
-echo "crossing: slices whose input already crosses (strata check: crossings or self-crossings > 0)"
+echo "welded: slices where strata slice joined pieces at a seam; crossing: slices whose input already crosses"
+echo "(strata check: crossings or self-crossings > 0)"
 echo "nest-viol: crossing-free slices whose inferred nesting strata check rejects"
 echo "slices in $out"
 echo
-printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %7s %s\n' outfit slices untangled failed vertices after \
-  "naive-x" "strata-x" tangled refused time bad
+printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %8s %9s %5s %7s %s\n' outfit slices untangled failed vertices \
+  after "naive-x" "strata-x" tangled refused "over-5%" "gap-ratio" "<0.9" time bad
 for r in "${srows[@]}"; do echo "$r"; done
 echo "untangled: inputs that crossed, untangled before simplifying; failed: not simplified (the"
 echo "reason is in the .simplify.json: e.g. a layer that crosses itself cannot be untangled);"
 echo "naive-x / strata-x: crossings after naive decimation / after strata; tangled: outputs not collision-free;"
+echo "over-5%: layers (of more than 3 vertices) kept more than 5% above their target;"
+echo "gap-ratio: smallest gap after / gap before over the near pairs (bench/gap_ratios.py); <0.9: pairs below 0.9;"
 echo "bad: of those, outputs of inputs that were collision-free as read (the guarantee)"
+echo "galleries: $out/<outfit>.html"
 # Fail when an output has crossings, or when an output of a collision-free input is not
 # collision-free (column "bad", the last of each row); tangled outputs of untangled
 # inputs (whose only possible fault left is the nesting check's reading of an open layer's
