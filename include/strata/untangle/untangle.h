@@ -48,7 +48,7 @@ struct UntangleParams {
     /// date with the current geometry and the untangling runs again. >= 1.
     /// The defaults (64 passes of one round of 10 steps; shape matching toward the input
     /// before every round but the first) refresh the fields often: with the finishing stage,
-    /// 12 concentric loops x 15 vertices (172 crossings) untangle in 1.3 s on one core
+    /// 12 concentric loops of 15 vertices (172 crossings) untangled in 1.3 s on one core
     /// against 26 s with 8 passes of 60 rounds of 30 steps (docs/untangle.md).
     int max_passes = 64;
     /// Smallest separation the untangling aims for between any two constrained layers, scene
