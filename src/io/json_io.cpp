@@ -30,6 +30,34 @@ std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size
     return {line, column};
 }
 
+// Deepest nesting of arrays/objects accepted. A scene needs 4 levels (top, layers, a layer's
+// points, a point); metadata may nest further. nlohmann's DOM (its destructor and dump()) recurse
+// per level, so an unbounded depth can overflow the stack.
+constexpr std::size_t kMaxJsonDepth = 256;
+
+// Byte offset of the first '[' or '{' that opens a level deeper than kMaxJsonDepth, skipping
+// string contents; npos when the nesting stays within the limit.
+std::size_t too_deep_at(std::string_view text) {
+    std::size_t depth = 0;
+    bool in_string = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth) return i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return std::string_view::npos;
+}
+
 std::string shown(const json& value) {
     std::string text = value.dump();
     if (text.size() > 60) text = text.substr(0, 57) + "...";
@@ -112,6 +140,13 @@ class Reader {
     }
 
     Scene scene(std::string_view text) const {
+        if (const std::size_t deep = too_deep_at(text); deep != std::string_view::npos) {
+            const auto [line, column] = line_column(text, deep);
+            throw InvalidInput(source_ + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                               ": invalid JSON: nesting deeper than " +
+                               std::to_string(kMaxJsonDepth) + " levels (found '" +
+                               std::string(1, text[deep]) + "')");
+        }
         json root;
         try {
             root = json::parse(text.begin(), text.end());
