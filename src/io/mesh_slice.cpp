@@ -22,8 +22,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -397,6 +399,166 @@ std::optional<std::vector<glm::dvec3>> read_ascii_vertices(const std::filesystem
     return out;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Validation of a text mesh before OpenMesh reads it: OpenMesh drops a face with a bad index and
+// keeps NaN coordinates silently, so the cause ("the mesh has no faces") would be lost.
+
+struct TextToken {
+    std::string text;
+    std::size_t line = 0, column = 0;
+};
+
+// Whitespace-separated tokens of one line, with their 1-based columns.
+std::vector<TextToken> line_tokens(const std::string& line, std::size_t line_number) {
+    std::vector<TextToken> out;
+    std::size_t i = 0;
+    while (i < line.size()) {
+        while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+        const std::size_t start = i;
+        while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+        if (i > start) out.push_back({line.substr(start, i - start), line_number, start + 1});
+    }
+    return out;
+}
+
+[[noreturn]] void mesh_text_error(const std::filesystem::path& path, const TextToken& at,
+                                  const std::string& what) {
+    throw InvalidInput(path.string() + ":" + std::to_string(at.line) + ":" +
+                       std::to_string(at.column) + ": " + what);
+}
+
+std::string shown_token(const std::string& text) {
+    return text.size() > 40 ? text.substr(0, 37) + "..." : text;
+}
+
+// A finite coordinate, or an error naming the token.
+void check_coordinate(const std::filesystem::path& path, const TextToken& t) {
+    const char* begin = t.text.c_str();
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    if (end == begin || *end != '\0')
+        mesh_text_error(path, t, "expected a number (got '" + shown_token(t.text) + "')");
+    if (!std::isfinite(v))
+        mesh_text_error(path, t, "coordinate is not finite (got '" + shown_token(t.text) + "')");
+}
+
+// An integer token, or an error naming it.
+long long integer_token(const std::filesystem::path& path, const TextToken& t,
+                        const std::string& text, const char* what) {
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long long v = std::strtoll(begin, &end, 10);
+    if (end == begin || *end != '\0' || errno == ERANGE)
+        mesh_text_error(path, t,
+                        std::string("expected ") + what + " (got '" + shown_token(t.text) + "')");
+    return v;
+}
+
+void validate_obj_text(const std::filesystem::path& path, std::istream& in) {
+    std::vector<std::vector<TextToken>> faces;
+    long long vertices = 0;
+    std::string line;
+    for (std::size_t n = 1; std::getline(in, line); ++n) {
+        auto tokens = line_tokens(line.substr(0, line.find('#')), n);
+        if (tokens.empty()) continue;
+        if (tokens[0].text == "v") {
+            if (tokens.size() < 4) {
+                TextToken at = tokens.back();
+                at.column += at.text.size();
+                mesh_text_error(
+                    path, at,
+                    "a vertex needs 3 coordinates (got " + std::to_string(tokens.size() - 1) + ")");
+            }
+            for (std::size_t k = 1; k < 4; ++k) check_coordinate(path, tokens[k]);
+            ++vertices;
+        } else if (tokens[0].text == "f") {
+            tokens.push_back({std::to_string(vertices), n, 0});  // vertices defined so far
+            faces.push_back(std::move(tokens));
+        }
+    }
+    for (const auto& face : faces) {
+        const long long before = std::stoll(face.back().text);
+        for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+            const TextToken& t = face[k];
+            const long long i =
+                integer_token(path, t, t.text.substr(0, t.text.find('/')), "a vertex index");
+            const long long resolved = i < 0 ? before + i + 1 : i;
+            if (i == 0 || resolved < 1 || resolved > vertices)
+                mesh_text_error(path, t,
+                                "face names vertex " + std::to_string(i) +
+                                    ", which does not exist (" + std::to_string(vertices) +
+                                    " vertices)");
+        }
+    }
+}
+
+void validate_off_text(const std::filesystem::path& path, std::istream& in) {
+    std::vector<TextToken> tokens;
+    std::string line;
+    for (std::size_t n = 1; std::getline(in, line); ++n)
+        for (auto& t : line_tokens(line.substr(0, line.find('#')), n))
+            tokens.push_back(std::move(t));
+    if (tokens.empty() || tokens[0].text != "OFF") return;  // other OFF variants: OpenMesh decides
+    std::size_t next = 1;
+    auto take = [&](const char* what) -> const TextToken& {
+        if (next >= tokens.size()) {
+            TextToken at = tokens.back();
+            at.column += at.text.size();
+            mesh_text_error(path, at, std::string("file ends early: expected ") + what);
+        }
+        return tokens[next++];
+    };
+    long long counts[3] = {0, 0, 0};
+    for (long long& c : counts) {
+        const TextToken& t = take("the vertex, face and edge counts");
+        c = integer_token(path, t, t.text, "a count");
+        if (c < 0) mesh_text_error(path, t, "count is negative (got '" + t.text + "')");
+    }
+    for (long long v = 0; v < counts[0]; ++v)
+        for (int k = 0; k < 3; ++k) check_coordinate(path, take("a vertex coordinate"));
+    for (long long f = 0; f < counts[1]; ++f) {
+        const TextToken& ct = take("a face");
+        const long long size = integer_token(path, ct, ct.text, "a face size");
+        if (size < 0) mesh_text_error(path, ct, "face size is negative (got '" + ct.text + "')");
+        const std::size_t face_line = ct.line;
+        for (long long k = 0; k < size; ++k) {
+            const TextToken& t = take("a face vertex index");
+            const long long i = integer_token(path, t, t.text, "a vertex index");
+            if (i < 0 || i >= counts[0])
+                mesh_text_error(path, t,
+                                "face names vertex " + std::to_string(i) +
+                                    ", which does not exist (" + std::to_string(counts[0]) +
+                                    " vertices)");
+        }
+        while (next < tokens.size() && tokens[next].line == face_line) ++next;  // face colour
+    }
+}
+
+void validate_stl_text(const std::filesystem::path& path, std::istream& in) {
+    std::string line;
+    for (std::size_t n = 1; std::getline(in, line); ++n) {
+        const auto tokens = line_tokens(line, n);
+        if (n == 1 && (tokens.empty() || tokens[0].text != "solid")) return;  // binary STL
+        if (tokens.empty() || tokens[0].text != "vertex") continue;
+        if (tokens.size() < 4) mesh_text_error(path, tokens[0], "a vertex needs 3 coordinates");
+        for (std::size_t k = 1; k < 4; ++k) check_coordinate(path, tokens[k]);
+    }
+}
+
+// Refuses non-finite coordinates and faces naming missing vertices in OBJ, plain OFF and ASCII
+// STL files, with the file's line and column; other files are left to OpenMesh.
+void validate_mesh_text(const std::filesystem::path& path, const std::string& ext) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return;
+    if (ext == ".obj")
+        validate_obj_text(path, in);
+    else if (ext == ".off")
+        validate_off_text(path, in);
+    else if (ext == ".stl")
+        validate_stl_text(path, in);
+}
+
 }  // namespace
 
 // -------------------------------------------------------------------------------------------------
@@ -538,6 +700,7 @@ SliceMesh read_slice_mesh(const std::filesystem::path& path, const std::string& 
     if (!std::filesystem::is_regular_file(path, ec))
         throw IoError(path.string() + ": cannot open mesh (no such file)");
 
+    validate_mesh_text(path, ext);
     OmMesh om;
     om.request_face_status();
     om.request_edge_status();
