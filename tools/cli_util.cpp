@@ -1,6 +1,7 @@
 #include "cli_util.h"
 
 #include "strata/core/error.h"
+#include "strata/geometry/predicates.h"
 #include "strata/io/atomic_file.h"
 
 #include <unistd.h>
@@ -87,6 +88,14 @@ const char* backend_name(FieldBackend backend) {
             return "indexed";
     }
     return "?";
+}
+
+bool is_flat(const std::vector<Vec2>& points) {
+    std::size_t far = 1;
+    while (far < points.size() && points[far] == points[0]) ++far;
+    for (std::size_t i = far + 1; i < points.size(); ++i)
+        if (orient2d(points[0], points[far], points[i]) != 0) return false;
+    return true;
 }
 
 }  // namespace strata::cli

@@ -59,4 +59,7 @@ Scene with_default_thickness(const Scene& scene, double thickness);
 /// "grid", "exact", "indexed".
 const char* backend_name(FieldBackend backend);
 
+// True when all `points` lie on one line (exact orientation tests): a closed layer so has no area.
+bool is_flat(const std::vector<Vec2>& points);
+
 }  // namespace strata::cli

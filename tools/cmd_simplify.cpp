@@ -164,10 +164,16 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
         const Crossing& c = check.crossings.front();
         text += "; first: layer '" + scene.layer(c.layer_a).name + "' segment " +
                 std::to_string(c.segment_a) + " x layer '" + scene.layer(c.layer_b).name +
-                "' segment " + std::to_string(c.segment_b) + " at (" +
-                format_number(c.point.x) + ", " + format_number(c.point.y) + ")";
+                "' segment " + std::to_string(c.segment_b) + " at (" + format_number(c.point.x) +
+                ", " + format_number(c.point.y) + ")";
     } else if (!check.self_crossings.empty()) {
         const Crossing& c = check.self_crossings.front();
+        const Layer& layer = scene.layer(c.layer_a);
+        if (layer.closed && is_flat(layer.points)) {
+            text += "; first: layer '" + layer.name +
+                    "' is flat: all its points are collinear (a closed layer needs an area)";
+            return text;
+        }
         text += "; first: layer '" + scene.layer(c.layer_a).name + "' crosses itself (segments " +
                 std::to_string(c.segment_a) + " and " + std::to_string(c.segment_b) + " at (" +
                 format_number(c.point.x) + ", " + format_number(c.point.y) + "))";
@@ -183,8 +189,8 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
 // Simplification keeps a collision-free scene so. An input that already crosses is untangled
 // first (InputCrossings::Untangle: the global untangling, which cannot mend a layer that
 // crosses itself), or refused (Fail: InvalidInput; Skip: std::nullopt).
-std::optional<Scene> prepare_input(const Scene& input, const std::string& name,
-                                   InputCrossings mode, const SimplifyParams& params,
+std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
+                                   const SimplifyParams& params,
                                    std::optional<InputUntangling>& untangled) {
     const CheckReport before = check_scene(input);
     if (before.is_collision_free()) return input;
@@ -358,11 +364,10 @@ int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files)
             after += l.after;
         }
         if (!o.report->collision_free) ++tangled;
-        std::printf("%-40s %8zu %8zu %7s %7s %7zu %8zu %9.3g %8.3f\n", name.c_str(), before,
-                    after, o.untangled ? std::to_string(o.untangled->crossings).c_str() : "0",
-                    o.naive ? std::to_string(o.naive->crossings).c_str() : "-",
-                    o.report->crossings, o.report->refused, max_hausdorff(*o.report),
-                    o.report->seconds_total);
+        std::printf("%-40s %8zu %8zu %7s %7s %7zu %8zu %9.3g %8.3f\n", name.c_str(), before, after,
+                    o.untangled ? std::to_string(o.untangled->crossings).c_str() : "0",
+                    o.naive ? std::to_string(o.naive->crossings).c_str() : "-", o.report->crossings,
+                    o.report->refused, max_hausdorff(*o.report), o.report->seconds_total);
         nlohmann::json j = report_json(*o.report, o.naive ? &*o.naive : nullptr);
         j["input"] = o.input;
         j["output"] = o.output;
@@ -497,7 +502,8 @@ Run add_simplify_command(CLI::App& app) {
         if (!o.svg.empty()) {
             SvgWriteParams svg;
             svg.width_px = 1000.0;
-            std::vector<SvgPanel> panels{{untangled ? "input (crossing)" : "input", &input, nullptr}};
+            std::vector<SvgPanel> panels{
+                {untangled ? "input (crossing)" : "input", &input, nullptr}};
             if (untangled) panels.push_back({"input untangled", &*prepared, &input});
             if (naive_report && !o.naive) panels.push_back({"naive decimation", &naive, &input});
             panels.push_back({o.naive ? "naive decimation" : "strata", &result, &input});

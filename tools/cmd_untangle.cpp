@@ -2,6 +2,7 @@
 #include "cli_util.h"
 #include "commands.h"
 
+#include "strata/core/format.h"
 #include "strata/geometry/checks.h"
 #include "strata/io/atomic_file.h"
 #include "strata/io/scene_io.h"
@@ -15,6 +16,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <string>
 
 namespace strata::cli {
 
@@ -129,13 +131,24 @@ Run add_untangle_command(CLI::App& app) {
             r.collision_free ? "collision-free"
             : r.converged    ? "converged, NOT collision-free"
                              : "NOT collision-free at the pass cap",
-            seconds,
-            r.seconds_fields, r.seconds_untangle, r.seconds_finish, r.seconds_check);
-        if (!r.collision_free)
-            std::fprintf(
-                stderr,
-                "strata: warning: the result is NOT collision-free (see 'strata check %s')\n",
-                opt->output.c_str());
+            seconds, r.seconds_fields, r.seconds_untangle, r.seconds_finish, r.seconds_check);
+        if (!r.collision_free) {
+            std::string why;
+            if (!after.self_crossings.empty()) {
+                const Crossing& c = after.self_crossings.front();
+                const Layer& layer = scene.layer(c.layer_a);
+                why = layer.closed && is_flat(layer.points)
+                          ? "; layer '" + layer.name + "' is flat: all its points are collinear"
+                          : "; layer '" + layer.name + "' crosses itself (segments " +
+                                std::to_string(c.segment_a) + " and " +
+                                std::to_string(c.segment_b) + " at (" + format_number(c.point.x) +
+                                ", " + format_number(c.point.y) + "))";
+            }
+            std::fprintf(stderr,
+                         "strata: warning: the result is NOT collision-free (%zu self-crossings%s; "
+                         "see 'strata check %s')\n",
+                         after.total_self_crossings(), why.c_str(), opt->output.c_str());
+        }
         return r.collision_free ? 0 : 1;
     };
 }
