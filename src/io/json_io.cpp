@@ -159,7 +159,19 @@ class Reader {
             throw InvalidInput(source_ + ":" + std::to_string(line) + ":" + std::to_string(column) +
                                ": invalid JSON: " + message);
         } catch (const json::exception& e) {  // e.g. a number too large for a double
-            throw InvalidInput(source_ + ": invalid JSON: " + e.what());
+            // nlohmann names the number ("... parsing '1e999'") but not where it is: find it.
+            const std::string message = e.what();
+            std::string where;
+            const std::size_t open = message.find("parsing '");
+            const std::size_t close = open == std::string::npos ? open : message.rfind('\'');
+            if (open != std::string::npos && close > open + 9) {
+                const std::string token = message.substr(open + 9, close - open - 9);
+                if (const std::size_t at = text.find(token); at != std::string_view::npos) {
+                    const auto [line, column] = line_column(text, at);
+                    where = ":" + std::to_string(line) + ":" + std::to_string(column);
+                }
+            }
+            throw InvalidInput(source_ + where + ": invalid JSON: " + message);
         }
         if (!root.is_object())
             fail("top level", "expected an object with \"layers\" (got " + shown(root) + ")");

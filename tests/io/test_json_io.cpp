@@ -76,6 +76,17 @@ TEST_CASE("bad JSON names the file, line and column", "[io][json]") {
     CHECK_THROWS_WITH(parse_scene_json("{\"layers\": [", "cut.json"), Contains("cut.json:1:13"));
 }
 
+TEST_CASE("deep nesting is refused with its position, not a stack overflow", "[io][json]") {
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    CHECK_THROWS_WITH(parse_scene_json(deep, "deep.json"),
+                      Contains("deep.json:1:257") && Contains("nesting deeper than 256"));
+    // Brackets inside strings do not count.
+    const std::string text = R"({"layers": [], "note": ")" + std::string(1000, '[') + "\"}";
+    CHECK(parse_scene_json(text, "s.json").size() == 0);
+    CHECK_THROWS_WITH(parse_scene_json(R"({"layers": [[1e999]]})", "big.json"),
+                      Contains("big.json:1:15") && Contains("1e999"));
+}
+
 TEST_CASE("bad content names the layer, the key and the value", "[io][json]") {
     auto fails = [](const std::string& text) {
         try {

@@ -754,3 +754,30 @@ TEST_CASE("real garments: same layers, vertices and nesting as the shared slices
         if (k.same_links) CHECK(summary(mine) == summary(ref));
     }
 }
+
+TEST_CASE("text meshes: a missing vertex or a non-finite coordinate names the line and value",
+          "[io][mesh]") {
+    auto fails = [](const std::string& name, const std::string& text) {
+        const auto path = temp_dir() / name;
+        std::ofstream(path) << text;
+        try {
+            read_slice_mesh(path, "m");
+        } catch (const InvalidInput& e) {
+            return std::string(e.what());
+        }
+        FAIL("no error for " << name);
+        return std::string();
+    };
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 1\n";
+    CHECK_THAT(fails("missing.obj", tri + "f 1 2 7\n"),
+               Contains("missing.obj:4:7") && Contains("vertex 7") && Contains("3 vertices"));
+    CHECK_THAT(fails("relative.obj", tri + "f -1 -2 -4\n"), Contains("relative.obj:4:9"));
+    CHECK_THAT(fails("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 1\nf 1 2 3\n"),
+               Contains("nan.obj:1:3") && Contains("'nan'"));
+    CHECK_THAT(fails("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 1\n3 0 1 3\n"),
+               Contains("bad.off:6:7") && Contains("vertex 3"));
+    CHECK_THAT(fails("inf.stl",
+                     "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 inf 0\n"
+                     "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n"),
+               Contains("inf.stl:5:10") && Contains("'inf'"));
+}
