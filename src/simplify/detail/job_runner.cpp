@@ -1,0 +1,230 @@
+#include "simplify/detail/job_runner.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+#include <utility>
+
+namespace strata::detail {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool is_waiting_stamp(const std::vector<Job>& waiting, std::uint32_t m) {
+    for (const Job& job : waiting)
+        if (job.stamp == m) return true;
+    return false;
+}
+
+}  // namespace
+
+JobRunner::JobRunner(const Scene& input, const SimplifyParams& params,
+                     const EngineSettings& settings, LivePolylines& live,
+                     const Separations& separations, const LocalCheck& check)
+    : input_(input),
+      params_(params),
+      settings_(settings),
+      live_(live),
+      separations_(separations),
+      check_(check) {
+    slots_.mark.resize(live.size());
+    for (std::size_t l = 0; l < live.size(); ++l)
+        slots_.mark[l].assign(live.layer(l).alive.size(), 0);
+    slots_.run = slots_.mark;
+    slots_.index = slots_.mark;
+}
+
+// Marks vertex v of layer k for the job being prepared; a vertex of a waiting job is left
+// alone and flags a conflict.
+void JobRunner::mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked,
+                     const std::vector<Job>& waiting) {
+    const std::uint32_t m = slots_.mark[k][v];
+    if (m == mark_counter_) return;
+    if (m != 0 && is_waiting_stamp(waiting, m)) {
+        conflict_ = true;
+        return;
+    }
+    slots_.mark[k][v] = mark_counter_;
+    marked.push_back(v);
+}
+
+// Runs of layer k through its `marked` vertices, extended by n_out on both sides, in the
+// order of their first input id. Costs O(marked * n_out), whatever the layer's size.
+void JobRunner::runs_of(std::size_t k, std::vector<std::size_t>& marked,
+                        const std::vector<Job>& waiting, std::vector<Run>& out) {
+    const WorkLayer& w = live_.layer(k);
+    const std::size_t seeds = marked.size();
+    for (std::size_t s = 0; s < seeds; ++s) {
+        std::size_t i = marked[s], j = marked[s];
+        for (std::size_t c = 0; c < params_.n_out; ++c) {
+            if (w.prev[i] != kNone) i = w.prev[i];
+            if (w.next[j] != kNone) j = w.next[j];
+            mark(k, i, marked, waiting);
+            mark(k, j, marked, waiting);
+        }
+    }
+    if (w.closed && marked.size() >= w.alive_count) {  // every vertex: the whole loop
+        Run run{k, {}, true};
+        const std::size_t start = *std::min_element(marked.begin(), marked.end());
+        std::size_t x = start;
+        do {
+            run.ids.push_back(x);
+            x = w.next[x];
+        } while (x != start);
+        out.push_back(std::move(run));
+        return;
+    }
+    std::vector<std::size_t> starts;
+    for (std::size_t v : marked)
+        if (!is_marked(k, w.prev[v])) starts.push_back(v);
+    std::sort(starts.begin(), starts.end());
+    for (std::size_t v : starts) {
+        Run run{k, {}, false};
+        for (std::size_t x = v; is_marked(k, x); x = w.next[x]) run.ids.push_back(x);
+        out.push_back(std::move(run));
+    }
+}
+
+JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting) {
+    const auto start = Clock::now();
+    const WorkLayer& w = live_.layer(job.l);
+    Box2 box;
+    box.extend(w.pos[job.a]);
+    box.extend(w.pos[job.b]);
+    box.extend(job.removed);
+    const double chord = glm::distance(w.pos[job.a], w.pos[job.b]);
+    const double nest = separations_.nest_thickness[job.l];
+    const Box2 region = box.inflated(std::max(2.0 * nest, 0.5 * chord));
+    const Box2 around = region.inflated(std::max(2.0 * nest, chord));
+    // Work layers: runs through the vertices of the segments near the region.
+    std::vector<std::vector<std::size_t>> marked(live_.size());
+    job.stamp = ++mark_counter_;
+    conflict_ = false;
+    if (params_.global) {
+        for (std::size_t k = 0; k < live_.size(); ++k)
+            for (std::size_t v = 0; v < live_.layer(k).alive.size(); ++v)
+                if (live_.layer(k).alive[v]) mark(k, v, marked[k], waiting);
+    } else {
+        live_.segments_near(around, [&](std::size_t k, std::size_t u) {
+            mark(k, u, marked[k], waiting);
+            mark(k, live_.layer(k).next[u], marked[k], waiting);
+        });
+    }
+    job.runs.clear();
+    for (std::size_t k = 0; k < live_.size() && !conflict_; ++k)
+        if (!marked[k].empty()) runs_of(k, marked[k], waiting, job.runs);
+    if (conflict_) return Prepared::Conflict;
+    job.footprint = Box2{};
+    job.footprint.extend(job.removed);
+    for (const Run& run : job.runs)
+        for (std::size_t id : run.ids) job.footprint.extend(live_.layer(run.layer).pos[id]);
+    if (meets_any(waiting, job.footprint.inflated(separations_.max_reach)))
+        return Prepared::Conflict;
+
+    std::vector<Layer> work_layers;
+    job.pieces.clear();
+    job.relations = RelationSource{};
+    job.relations.scene = &input_;
+    job.settings = settings_;
+    job.settings.outside_signs.clear();
+    job.settings.check_every_step = !params_.global;
+    job.settings.rest_at_start = true;  // passes of one round: match toward the start
+    for (std::size_t r = 0; r < job.runs.size(); ++r) {
+        const Run& run = job.runs[r];
+        const Layer& parent = input_.layer(run.layer);
+        const WorkLayer& parent_work = live_.layer(run.layer);
+        Layer layer;
+        layer.name = parent.name + "#" + std::to_string(r);
+        layer.closed = run.whole_loop;
+        layer.thickness = parent.thickness;
+        layer.weight = parent.weight;
+        layer.alpha = parent.alpha;
+        layer.beta = parent.beta;
+        Piece piece;
+        piece.layer = r;
+        piece.is_whole_loop = run.whole_loop;
+        for (std::size_t k = 0; k < run.ids.size(); ++k) {
+            const std::size_t id = run.ids[k];
+            const Vec2 p = parent_work.pos[id];
+            if (!layer.points.empty() && layer.points.back() == p)
+                return Prepared::Refused;  // would be merged
+            layer.points.push_back(p);
+            piece.vertices.push_back(k);
+            // Open layers keep their end vertices where they are.
+            const bool is_end = !parent_work.closed &&
+                                (parent_work.prev[id] == kNone || parent_work.next[id] == kNone);
+            piece.is_free.push_back(!is_end && (params_.global || region.contains(p)) ? 1 : 0);
+            slots_.run[run.layer][id] = static_cast<std::uint32_t>(r);
+            slots_.index[run.layer][id] = static_cast<std::uint32_t>(k);
+        }
+        if (layer.closed && layer.points.front() == layer.points.back()) return Prepared::Refused;
+        work_layers.push_back(std::move(layer));
+        job.pieces.push_back(std::move(piece));
+        job.relations.parent.push_back(run.layer);
+        job.settings.outside_signs.push_back(settings_.outside_signs[run.layer]);
+    }
+    job.work.emplace(std::move(work_layers));
+    job.moving.clear();
+    for (const Run& run : job.runs) {
+        const WorkLayer& o = live_.layer(run.layer);
+        for (std::size_t id : run.ids)
+            if (o.next[id] != kNone &&
+                (slots_.is_free(run.layer, id, job) || slots_.is_free(run.layer, o.next[id], job)))
+                job.moving.push_back(LivePolylines::ref(run.layer, id));
+    }
+    job.seconds_prepare = seconds_since(start);
+    return Prepared::Ready;
+}
+
+void JobRunner::execute(Job& job) const {
+    SegmentGrid moving(live_.grid().cell());
+    std::vector<SegRef> found;
+    auto is_ok = [&](const Scene& s) {
+        const Overlay ov(live_, slots_, job, s, moving, found);
+        moving.clear();
+        for (const SegRef& seg : job.moving) {
+            Box2 box;
+            box.extend(ov.pos(seg.layer, seg.start));
+            box.extend(ov.pos(seg.layer, live_.layer(seg.layer).next[seg.start]));
+            moving.insert(seg, box);
+        }
+        if (!check_.removal_clear(job.l, job.a, job.removed, job.b, ov)) return false;
+        for (std::size_t r = 0; r < job.runs.size(); ++r) {
+            const Run& run = job.runs[r];
+            const WorkLayer& o = live_.layer(run.layer);
+            for (std::size_t k = 0; k < run.ids.size(); ++k) {
+                if (!job.pieces[r].is_free[k]) continue;
+                const std::size_t id = run.ids[k];
+                if (o.prev[id] != kNone && !check_.segment_clear(run.layer, o.prev[id], id, ov))
+                    return false;
+                if (o.next[id] != kNone && !check_.segment_clear(run.layer, id, o.next[id], ov))
+                    return false;
+            }
+            if (!check_.closed_valid(run.layer, ov)) return false;
+        }
+        // Nesting of the region's vertices against every closed layer near it.
+        for (const Run& run : job.runs)
+            if (!check_.nesting_kept(run.layer, run.ids, ov)) return false;
+        return true;
+    };
+    job.result = run_engine(*job.work, job.pieces, params_.untangling, job.relations, job.settings,
+                            is_ok, {});
+}
+
+void JobRunner::apply(const Job& job) {
+    for (std::size_t r = 0; r < job.runs.size(); ++r) {
+        const Run& run = job.runs[r];
+        for (std::size_t k = 0; k < run.ids.size(); ++k)
+            if (job.pieces[r].is_free[k])
+                live_.move(run.layer, run.ids[k], job.work->layer(r).points[k]);
+    }
+}
+
+}  // namespace strata::detail

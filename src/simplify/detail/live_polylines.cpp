@@ -1,0 +1,112 @@
+#include "simplify/detail/live_polylines.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+namespace strata::detail {
+
+LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>& targets)
+    : grid_(1.0) {
+    const std::size_t n = scene.size();
+    layers_.resize(n);
+    std::vector<double> lengths;
+    for (std::size_t l = 0; l < n; ++l) {
+        const Layer& in = scene.layer(l);
+        WorkLayer& w = layers_[l];
+        const std::size_t m = in.points.size();
+        w.closed = in.closed;
+        w.original = w.pos = in.points;
+        w.prev.resize(m);
+        w.next.resize(m);
+        for (std::size_t i = 0; i < m; ++i) {
+            w.prev[i] = i > 0 ? i - 1 : (in.closed ? m - 1 : kNone);
+            w.next[i] = i + 1 < m ? i + 1 : (in.closed ? 0 : kNone);
+        }
+        w.alive.assign(m, 1);
+        w.locked.assign(m, 0);
+        w.alive_count = m;
+        w.target = targets[l];
+        for (std::size_t i = 0; i < in.segment_count(); ++i)
+            lengths.push_back(glm::distance(in.segment_start(i), in.segment_end(i)));
+    }
+    // Cells of 4 median segment lengths.
+    std::nth_element(lengths.begin(),
+                     lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2),
+                     lengths.end());
+    const double median = lengths.empty() ? 1.0 : lengths[lengths.size() / 2];
+    std::size_t segments = 0;
+    for (std::size_t l = 0; l < n; ++l) segments += scene.layer(l).segment_count();
+    grid_ = SegmentGrid(std::max(4.0 * median, std::numeric_limits<double>::min()), scene.bounds(),
+                        segments);
+    for (std::size_t l = 0; l < n; ++l)
+        for (std::size_t i = 0; i < layers_[l].alive.size(); ++i)
+            if (has_segment(l, i)) grid_.insert(ref(l, i), seg_box(l, i));
+    stamp_.resize(n);
+    for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
+}
+
+void LivePolylines::unlink(std::size_t l, std::size_t v) {
+    WorkLayer& w = layers_[l];
+    const std::size_t a = w.prev[v], b = w.next[v];
+    grid_.erase(ref(l, a), seg_box(l, a));
+    grid_.erase(ref(l, v), seg_box(l, v));
+    w.alive[v] = 0;
+    w.next[a] = b;
+    w.prev[b] = a;
+    --w.alive_count;
+    grid_.insert(ref(l, a), seg_box(l, a));
+}
+
+void LivePolylines::relink(std::size_t l, std::size_t v) {
+    WorkLayer& w = layers_[l];
+    const std::size_t a = w.prev[v], b = w.next[v];
+    grid_.erase(ref(l, a), seg_box(l, a));
+    w.alive[v] = 1;
+    w.next[a] = v;
+    w.prev[b] = v;
+    ++w.alive_count;
+    grid_.insert(ref(l, a), seg_box(l, a));
+    grid_.insert(ref(l, v), seg_box(l, v));
+}
+
+void LivePolylines::move(std::size_t l, std::size_t v, const Vec2& to) {
+    WorkLayer& w = layers_[l];
+    if (w.pos[v] == to) return;
+    const std::size_t a = w.prev[v];
+    if (a != kNone) grid_.erase(ref(l, a), seg_box(l, a));
+    if (w.next[v] != kNone) grid_.erase(ref(l, v), seg_box(l, v));
+    w.pos[v] = to;
+    if (a != kNone) grid_.insert(ref(l, a), seg_box(l, a));
+    if (w.next[v] != kNone) grid_.insert(ref(l, v), seg_box(l, v));
+}
+
+Scene LivePolylines::to_scene(const Scene& input) const {
+    std::vector<Layer> layers = input.layers();
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+        const WorkLayer& w = layers_[l];
+        std::vector<Vec2> points;
+        const std::size_t start = w.first();
+        std::size_t i = start;
+        do {
+            points.push_back(w.pos[i]);
+            i = w.next[i];
+        } while (i != kNone && i != start);
+        layers[l].points = std::move(points);
+    }
+    Scene out(std::move(layers), input.units());
+    out.metadata = input.metadata;
+    return out;
+}
+
+double LivePolylines::max_displacement(std::size_t l) const {
+    const WorkLayer& w = layers_[l];
+    double d = 0.0;
+    for (std::size_t i = 0; i < w.alive.size(); ++i)
+        if (w.alive[i]) d = std::max(d, glm::distance(w.pos[i], w.original[i]));
+    return d;
+}
+
+}  // namespace strata::detail

@@ -1,0 +1,74 @@
+#pragma once
+/// @file The polylines being simplified: one WorkLayer per input layer (its alive vertices
+/// linked in order) and the SegmentGrid of their live segments, kept in step as vertices are
+/// unlinked, relinked or moved. Private to src/simplify.
+
+#include "simplify/detail/segment_grid.h"
+#include "simplify/detail/work_layer.h"
+#include "strata/geometry/scene.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace strata::detail {
+
+class LivePolylines {
+  public:
+    /// Every vertex of `scene` alive; targets[l]: the vertex count layer l should come down to.
+    LivePolylines(const Scene& scene, const std::vector<std::size_t>& targets);
+
+    std::size_t size() const { return layers_.size(); }
+    const WorkLayer& layer(std::size_t l) const { return layers_[l]; }
+    /// The live segments, each indexed by its bounding box.
+    const SegmentGrid& grid() const { return grid_; }
+    /// Vertex v of layer l is not to be removed any more.
+    void lock(std::size_t l, std::size_t v) { layers_[l].locked[v] = 1; }
+
+    /// Takes alive vertex v (not an end of an open layer) out: its neighbours are joined.
+    void unlink(std::size_t l, std::size_t v);
+    /// Undoes unlink(l, v) (its neighbours then are still linked to each other).
+    void relink(std::size_t l, std::size_t v);
+    /// Moves vertex v of layer l to `to`.
+    void move(std::size_t l, std::size_t v, const Vec2& to);
+
+    /// Calls f(layer, start) once per live segment whose box meets `box`.
+    template <class F>
+    void segments_near(const Box2& box, F&& f) {
+        ++stamp_counter_;
+        grid_.query(box, [&](SegRef s) {
+            std::uint32_t& mark = stamp_[s.layer][s.start];
+            if (mark == stamp_counter_) return;
+            mark = stamp_counter_;
+            f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+        });
+    }
+
+    /// `input` (layers, metadata) with the alive vertices of every layer, in order.
+    Scene to_scene(const Scene& input) const;
+    /// Largest distance of an alive vertex of layer l from its input position.
+    double max_displacement(std::size_t l) const;
+
+    /// The grid's name of the segment starting at vertex i of layer l.
+    static SegRef ref(std::size_t l, std::size_t i) {
+        return {static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)};
+    }
+
+  private:
+    bool has_segment(std::size_t l, std::size_t i) const {
+        return layers_[l].alive[i] && layers_[l].next[i] != kNone;
+    }
+    Box2 seg_box(std::size_t l, std::size_t i) const {
+        Box2 box;
+        box.extend(layers_[l].pos[i]);
+        box.extend(layers_[l].pos[layers_[l].next[i]]);
+        return box;
+    }
+
+    std::vector<WorkLayer> layers_;
+    SegmentGrid grid_;
+    std::vector<std::vector<std::uint32_t>> stamp_;  // per segment: last segments_near() to meet it
+    std::uint32_t stamp_counter_ = 0;
+};
+
+}  // namespace strata::detail

@@ -1,0 +1,177 @@
+#include "simplify/detail/local_check.h"
+
+#include "strata/geometry/predicates.h"
+
+#include <algorithm>
+#include <optional>
+
+namespace strata::detail {
+
+namespace {
+
+bool point_in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
+    const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+}
+
+double segment_distance(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
+    return std::min(
+        std::min(point_segment_distance(p0, q0, q1), point_segment_distance(p1, q0, q1)),
+        std::min(point_segment_distance(q0, p0, p1), point_segment_distance(q1, p0, p1)));
+}
+
+}  // namespace
+
+bool LocalCheck::removal_clear(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
+                               const Overlay& ov) const {
+    return closed_valid(l, ov) && triangle_empty(l, a, removed, b, ov) &&
+           segment_clear(l, a, b, ov);
+}
+
+bool LocalCheck::segment_clear(std::size_t l, std::size_t a, std::size_t b,
+                               const Overlay& ov) const {
+    const Vec2 p = ov.pos(l, a), q = ov.pos(l, b);
+    Box2 box;
+    box.extend(p);
+    box.extend(q);
+    bool ok = true;
+    ov.near(box.inflated(separations_.reach[l]), [&](std::size_t k, std::size_t u) {
+        if (!ok) return;
+        const std::size_t u2 = live_.layer(k).next[u];
+        if (k == l && (u == a || u == b || u2 == a || u2 == b)) return;
+        const Vec2 s0 = ov.pos(k, u), s1 = ov.pos(k, u2);
+        if (segment_contact(p, q, s0, s1) != SegmentContact::None) {
+            ok = false;
+            return;
+        }
+        const double need = separations_.need[l][k];
+        if (k != l && need > 0.0 && segment_distance(p, q, s0, s1) < need) ok = false;
+    });
+    return ok;
+}
+
+bool LocalCheck::closed_valid(std::size_t l, const Overlay& ov) const {
+    const WorkLayer& w = live_.layer(l);
+    if (!w.closed || w.alive_count > 3) return true;
+    const std::size_t i = w.first(), j = w.next[i], k = w.next[j];
+    return orient2d(ov.pos(l, i), ov.pos(l, j), ov.pos(l, k)) != 0;
+}
+
+// Whether w (of layer k) lies strictly on the side of segment (pa, pb) of layer l that the
+// nesting asks for: inside l when k is under l, outside when over (false for side-by-side
+// layers, where the side of an open layer is not said).
+bool LocalCheck::on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
+                                const Vec2& w) const {
+    const Relation r = input_.relation(k, l);
+    if (r != Relation::Under && r != Relation::Over) return false;
+    const int outside = outside_signs_[l];  // +1: outside on the right
+    const int wanted = r == Relation::Under ? outside : -outside;
+    return orient2d(pa, pb, w) == wanted;
+}
+
+// No vertex but a, b of any layer lies in the closed triangle (a, removed, b). Over a job
+// (after its untangling), a vertex of another layer on its own side of the chord (a, b) is
+// allowed there.
+bool LocalCheck::triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
+                                const Overlay& ov) const {
+    const Vec2 pa = ov.pos(l, a), pb = ov.pos(l, b);
+    Box2 box;
+    box.extend(pa);
+    box.extend(pb);
+    box.extend(removed);
+    bool ok = true;
+    ov.near(box, [&](std::size_t k, std::size_t u) {
+        if (!ok) return;
+        for (std::size_t x : {u, live_.layer(k).next[u]}) {
+            if (k == l && (x == a || x == b)) continue;
+            if (point_in_closed_triangle(pa, removed, pb, ov.pos(k, x))) {
+                // After an untangling the triangle is no longer swept: a vertex of another
+                // layer may have moved into it from the side it belongs on.
+                if (ov.job() && k != l && on_wanted_side(k, l, pa, pb, ov.pos(k, x))) continue;
+                ok = false;
+                return;
+            }
+        }
+    });
+    return ok;
+}
+
+// The segments of closed layer k that the overlay's job changes, as (start, end) pairs: their
+// old versions (live positions) in `olds`, their new ones (the overlay's) in `news`. Those
+// are the segments next to the job's free vertices of k, and on the removal's own layer the
+// chord (a, b), whose old version is (a, v) and (v, b).
+void LocalCheck::changed_segments(std::size_t k, const Overlay& ov, std::vector<Vec2>& olds,
+                                  std::vector<Vec2>& news) const {
+    const Job& job = *ov.job();
+    const WorkLayer& w = live_.layer(k);
+    std::vector<std::size_t> starts;
+    for (std::size_t r = 0; r < job.runs.size(); ++r) {
+        if (job.runs[r].layer != k) continue;
+        const std::vector<std::size_t>& ids = job.runs[r].ids;
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+            if (!job.pieces[r].is_free[i]) continue;
+            if (w.prev[ids[i]] != kNone) starts.push_back(w.prev[ids[i]]);
+            if (w.next[ids[i]] != kNone) starts.push_back(ids[i]);
+        }
+    }
+    if (k == job.l) starts.push_back(job.a);
+    std::sort(starts.begin(), starts.end());
+    starts.erase(std::unique(starts.begin(), starts.end()), starts.end());
+    olds.clear();
+    news.clear();
+    for (std::size_t s : starts) {
+        const std::size_t t = w.next[s];
+        news.push_back(ov.pos(k, s));
+        news.push_back(ov.pos(k, t));
+        if (k == job.l && s == job.a) {
+            olds.insert(olds.end(), {w.pos[s], job.removed, job.removed, w.pos[t]});
+        } else {
+            olds.insert(olds.end(), {w.pos[s], w.pos[t]});
+        }
+    }
+}
+
+// Moving vertices could carry a whole small loop out of another without any crossing left at
+// the end. Tested locally and exactly, so that the cost does not grow with the layers: the
+// change of the winding number of closed layer k around a vertex that moves from p0 to p1 is
+// the change at p0 caused by the segments of k the job changed, plus the crossings of the
+// path p0 -> p1 with k where it is now (winding_contribution(), winding_change_across()). Any
+// change, or a path that touches k, fails. The live polylines are collision-free before the
+// job, so an unchanged side is the right one.
+bool LocalCheck::nesting_kept(std::size_t l, const std::vector<std::size_t>& ids,
+                              const Overlay& ov) const {
+    std::vector<Vec2> olds, news;
+    for (std::size_t k = 0; k < live_.size(); ++k) {
+        if (k == l || !live_.layer(k).closed) continue;
+        changed_segments(k, ov, olds, news);
+        for (std::size_t id : ids) {
+            const Vec2 p0 = live_.layer(l).pos[id], p1 = ov.pos(l, id);
+            int change = 0;
+            for (std::size_t i = 0; i < news.size(); i += 2)
+                change += winding_contribution(news[i], news[i + 1], p0);
+            for (std::size_t i = 0; i < olds.size(); i += 2)
+                change -= winding_contribution(olds[i], olds[i + 1], p0);
+            if (p1 != p0) {
+                Box2 path;
+                path.extend(p0);
+                path.extend(p1);
+                bool touches = false;
+                ov.near(path, [&](std::size_t j, std::size_t u) {
+                    if (j != k || touches) return;
+                    const std::optional<int> across = winding_change_across(
+                        p0, p1, ov.pos(k, u), ov.pos(k, live_.layer(k).next[u]));
+                    if (across) {
+                        change += *across;
+                    } else {
+                        touches = true;
+                    }
+                });
+                if (touches) return false;
+            }
+            if (change != 0) return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace strata::detail

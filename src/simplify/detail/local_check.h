@@ -1,0 +1,52 @@
+#pragma once
+/// @file The exact local test of the simplification driver: a removal, or the result of an
+/// untangling job, keeps the region around it collision-free (no crossing, every separation,
+/// nesting kept, closed layers not flat). It reads positions through an Overlay and looks only
+/// at the segments near the change, so that its cost does not grow with the scene. Private to
+/// src/simplify.
+
+#include "simplify/detail/live_polylines.h"
+#include "simplify/detail/separations.h"
+#include "simplify/detail/untangle_job.h"
+#include "strata/geometry/scene.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace strata::detail {
+
+class LocalCheck {
+  public:
+    /// `outside_signs`: outside_side() of every layer of `input`; read only by the checks
+    /// over a job. Keeps references to every argument.
+    LocalCheck(const Scene& input, const LivePolylines& live, const Separations& separations,
+               const std::vector<int>& outside_signs)
+        : input_(input), live_(live), separations_(separations), outside_signs_(outside_signs) {}
+
+    /// The removal of the vertex at `removed` between a and b (unlinked) of layer l: layer l
+    /// stays valid, the closed triangle (a, removed, b) holds no other vertex, and the chord
+    /// (a, b) meets nothing and keeps its separations.
+    bool removal_clear(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
+                       const Overlay& ov) const;
+    /// Segment (a, b) of layer l meets no other segment and keeps its separations.
+    bool segment_clear(std::size_t l, std::size_t a, std::size_t b, const Overlay& ov) const;
+    /// Layer l, if closed and down to 3 vertices, is not flat.
+    bool closed_valid(std::size_t l, const Overlay& ov) const;
+    /// Over a job: every vertex of `ids` (layer l) stays on its side of every closed layer.
+    bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids, const Overlay& ov) const;
+
+  private:
+    bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
+                        const Vec2& w) const;
+    bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
+                        const Overlay& ov) const;
+    void changed_segments(std::size_t k, const Overlay& ov, std::vector<Vec2>& olds,
+                          std::vector<Vec2>& news) const;
+
+    const Scene& input_;
+    const LivePolylines& live_;
+    const Separations& separations_;
+    const std::vector<int>& outside_signs_;
+};
+
+}  // namespace strata::detail
