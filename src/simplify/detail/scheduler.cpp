@@ -293,7 +293,6 @@ void Scheduler::flush() {
         report_.seconds_fields += job.result.seconds_fields;  // the first run's time
         report_.seconds_untangle += job.result.seconds_untangle;
         report_.seconds_finish += job.result.seconds_finish;
-        report_.seconds_finish += job.result.seconds_finish;
         report_.seconds_check += job.result.seconds_check + job.seconds_prepare;
         ++report_.batch_reruns;
         conclude(job.l, job.v, untangle_now(job.l, job.v));
