@@ -285,22 +285,14 @@ int main(int argc, char** argv) {
                 filter.closed = value == "closed";
             } else if (key == "--decimator") {
                 filter.decimator = value;
-            } else if (key == "--give-up") {
+            } else if (key == "--give-up" || key == "--finish") {
                 if (value != "0" && value != "1" && value != "0,1" && value != "1,0") {
                     std::fprintf(stderr,
-                                 "strata_bench_simplify: --give-up must be 0, 1 or 0,1 (got %s)\n",
-                                 value.c_str());
+                                 "strata_bench_simplify: %s must be 0, 1 or 0,1 (got %s)\n",
+                                 key.c_str(), value.c_str());
                     return 2;
                 }
-                filter.give_up = numbers(value);
-            } else if (key == "--finish") {
-                if (value != "0" && value != "1" && value != "0,1" && value != "1,0") {
-                    std::fprintf(stderr,
-                                 "strata_bench_simplify: --finish must be 0, 1 or 0,1 (got %s)\n",
-                                 value.c_str());
-                    return 2;
-                }
-                filter.finish = numbers(value);
+                (key == "--give-up" ? filter.give_up : filter.finish) = numbers(value);
             } else if (key == "--schedule") {
                 filter.schedule = value;
             } else if (key == "--backend") {
