@@ -33,6 +33,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -236,6 +237,7 @@ int main(int argc, char** argv) {
                      backend.c_str());
         return 2;
     }
+    if (!write_dir.empty()) std::filesystem::create_directories(write_dir);
     UntangleParams params;
     params.field.backend = backend == "grid" ? FieldBackend::Grid : FieldBackend::ExactIndexed;
     std::printf("%-22s %-8s %11s %11s %11s %7s %6s %8s %8s %10s %5s\n", "scene", "tangle",

@@ -213,11 +213,11 @@ double automatic_near(const Scene& scene) {
     return std::max(0.05 * std::hypot(size.x, size.y), 2.0 * max_required);
 }
 
-// Side of `v` with respect to the open or closed layer of `index`, at its closest point:
-// +1 right of the direction of travel, -1 left, 0 when not decided (farther than `near`, on
-// the layer, or closest to an end point of an open layer).
-int side_at(const SegmentIndex& index, const Vec2& v, double near) {
-    const Nearest n = nearest_on(index, v, near);
+// Side of `v` with respect to the open or closed layer of `index`, given `n`, its closest
+// point there within `near` (not found when farther): +1 right of the direction of travel, -1
+// left, 0 when not decided (farther than `near`, on the layer, or closest to an end point of
+// an open layer).
+int side_of(const SegmentIndex& index, const Vec2& v, const Nearest& n) {
     if (!n.found() || n.distance == 0.0) return 0;
     const std::size_t s = n.segment;
     const Vec2 a = index.start(s), b = index.end(s);
@@ -243,6 +243,11 @@ int side_at(const SegmentIndex& index, const Vec2& v, double near) {
     if (turn > 0) return (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
     if (turn < 0) return (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
     return o1 != 0 ? -o1 : -o2;
+}
+
+// side_of() at the closest point within `near`.
+int side_at(const SegmentIndex& index, const Vec2& v, double near) {
+    return side_of(index, v, nearest_on(index, v, near));
 }
 
 int closed_outside(const Layer& layer) {
@@ -374,6 +379,7 @@ class Checker {
 
     CheckReport run() {
         find_contacts();
+        find_outside_sides();
         find_separations();
         find_nesting_violations();
         return std::move(report_);
@@ -488,13 +494,21 @@ class Checker {
                 pair.at_a = pair.at_b = met_point_[i * n_ + j];
                 std::vector<SeparationViolation> violations;
                 auto scan = [&](std::size_t from, std::size_t to, bool from_is_a) {
+                    // Where nesting is decided by the side at the closest point, the same
+                    // queries (then with the whole cutoff >= near) decide it too.
+                    const bool sides = sides_by_nearest(from, to);
+                    if (sides) sides_scanned_[from * n_ + to] = 1;
                     const std::vector<Vec2>& points = scene_.layer(from).points;
                     for (std::size_t k = 0; k < points.size(); ++k) {
                         // Only a vertex closer than the pair's gap so far, or than required,
-                        // changes anything: the search stops there.
-                        const double bound = std::max(threshold, std::min(cutoff, pair.gap));
+                        // changes the separation: the search stops there.
+                        const double bound =
+                            sides ? cutoff : std::max(threshold, std::min(cutoff, pair.gap));
                         const Nearest nr = nearest_on(indices_[to], points[k], bound);
                         if (!nr.found()) continue;
+                        if (sides && nr.distance < near &&
+                            breaks_nesting(from, to, side_of(indices_[to], points[k], nr)))
+                            wrong_side_[from * n_ + to].push_back(k);
                         if (nr.distance < pair.gap) {
                             pair.gap = nr.distance;
                             pair.at_a = from_is_a ? points[k] : nr.point;
@@ -530,21 +544,48 @@ class Checker {
         report_.pairs.push_back(pair);
     }
 
-    void find_nesting_violations() {
-        const double near = report_.near_distance;
-        std::vector<int> outside(n_, 0);
+    // Outside sides of the open layers (see outside_side()).
+    void find_outside_sides() {
+        outside_.assign(n_, 0);
         for (std::size_t b = 0; b < n_; ++b)
             if (!scene_.layer(b).closed)
-                outside[b] = params_.outside_sides.empty()
-                                 ? open_outside(scene_, b, indices_[b], near)
-                                 : params_.outside_sides[b];
+                outside_[b] = params_.outside_sides.empty()
+                                  ? open_outside(scene_, b, indices_[b], report_.near_distance)
+                                  : params_.outside_sides[b];
+        sides_scanned_.assign(n_ * n_, 0);
+        wrong_side_.assign(n_ * n_, {});
+    }
+
+    // Nesting of layer a against open layer b is decided by the side of b at each vertex's
+    // closest point (within near); false where it is decided otherwise or not at all.
+    bool sides_by_nearest(std::size_t a, std::size_t b) const {
+        return !scene_.layer(b).closed && scene_.relation(a, b) != Relation::SideBySide &&
+               bounds_[a].overlaps(bounds_[b].inflated(report_.near_distance));
+    }
+
+    // A vertex of layer a on `side` (side_of()) of open layer b breaks their nesting.
+    bool breaks_nesting(std::size_t a, std::size_t b, int side) const {
+        const Relation rel = scene_.relation(a, b);
+        return side != 0 && (rel == Relation::Under ? side == outside_[b] : side == -outside_[b]);
+    }
+
+    void find_nesting_violations() {
+        const double near = report_.near_distance;
         for (std::size_t a = 0; a < n_; ++a)
             for (std::size_t b = 0; b < n_; ++b) {
                 if (a == b) continue;
                 const Relation rel = scene_.relation(a, b);
                 const Layer& other = scene_.layer(b);
-                if (!other.closed && rel == Relation::SideBySide) continue;
-                if (!other.closed && !bounds_[a].overlaps(bounds_[b].inflated(near))) continue;
+                if (!other.closed && !sides_by_nearest(a, b)) continue;
+                auto add = [&](std::size_t k) {
+                    ++report_.nesting_violation_count;
+                    if (report_.nesting_violations.size() < params_.max_listed)
+                        report_.nesting_violations.push_back({a, k, b, rel});
+                };
+                if (sides_scanned_[a * n_ + b]) {  // find_separations() found them
+                    for (std::size_t k : wrong_side_[a * n_ + b]) add(k);
+                    continue;
+                }
                 const std::vector<Vec2>& points = scene_.layer(a).points;
                 for (std::size_t k = 0; k < points.size(); ++k) {
                     bool broken = false;
@@ -553,14 +594,9 @@ class Checker {
                         broken = rel == Relation::Under ? where == Placement::Outside
                                                         : where == Placement::Inside;
                     } else {
-                        const int side = side_at(indices_[b], points[k], near);
-                        broken = side != 0 && (rel == Relation::Under ? side == outside[b]
-                                                                      : side == -outside[b]);
+                        broken = breaks_nesting(a, b, side_at(indices_[b], points[k], near));
                     }
-                    if (!broken) continue;
-                    ++report_.nesting_violation_count;
-                    if (report_.nesting_violations.size() < params_.max_listed)
-                        report_.nesting_violations.push_back({a, k, b, rel});
+                    if (broken) add(k);
                 }
             }
     }
@@ -572,6 +608,11 @@ class Checker {
     std::vector<Box2> bounds_;
     std::vector<char> met_;  // met_[a * n + b], a < b: the layers cross or touch
     std::vector<Vec2> met_point_;
+    std::vector<int> outside_;  // per open layer: outside_side()
+    // sides_scanned_[a * n + b]: find_separations() decided the nesting of a against b, and
+    // wrong_side_[a * n + b] lists the vertices of a on the wrong side of b.
+    std::vector<char> sides_scanned_;
+    std::vector<std::vector<std::size_t>> wrong_side_;
     CheckReport report_;
 };
 
