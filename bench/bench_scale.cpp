@@ -7,7 +7,8 @@
 // For every N: folded_stack(L, N) (the scene family of strata_bench_cgal, same segment length
 // at every size) is written as JSON into DIR; then, in one run,
 //   - library calls in this process: read_scene, check_scene (one core);
-//   - whole processes (fork + exec, wall time and the child's peak resident memory):
+//   - whole processes (fork + exec, wall time, the child's CPU time (user + system, which a
+//     busy machine disturbs less) and its peak resident memory):
 //     `strata check IN`, and for every R `strata simplify IN -o OUT --remove R` and the same
 //     with `--no-untangle` (naive decimation, the floor any simplifier pays).
 // Plain timers, one run per cell: the machine is small and noisy, read ratios.
@@ -37,7 +38,8 @@ double now() {
 }
 
 struct ProcessRun {
-    double seconds = 0.0;
+    double seconds = 0.0;      // wall
+    double cpu_seconds = 0.0;  // user + system, all threads
     double peak_mib = 0.0;
     int exit_code = -1;
 };
@@ -63,6 +65,10 @@ ProcessRun run_process(const std::vector<std::string>& args) {
     ProcessRun run;
     run.seconds = now() - start;
     run.peak_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;
+    auto secs = [](const timeval& t) {
+        return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+    };
+    run.cpu_seconds = secs(usage.ru_utime) + secs(usage.ru_stime);
     run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     return run;
 }
@@ -169,14 +175,15 @@ int main(int argc, char** argv) {
                 const ProcessRun s = run_process({strata, "simplify", row.path, "-o", out,
                                                   "--remove", remove, "--threads", threads});
                 const double per_removal_us = s.seconds / (total * r) * 1e6;
-                std::printf("| %s | %s | %.3f s (exit %d) | %.0f | %.2f us |", row.label.c_str(),
-                            remove, s.seconds, s.exit_code, s.peak_mib, per_removal_us);
+                std::printf("| %s | %s | %.3f s (cpu %.3f s, exit %d) | %.0f | %.2f us |",
+                            row.label.c_str(), remove, s.seconds, s.cpu_seconds, s.exit_code,
+                            s.peak_mib, per_removal_us);
                 if (naive) {
                     const ProcessRun nv =
                         run_process({strata, "simplify", row.path, "-o", out, "--remove", remove,
                                      "--threads", threads, "--no-untangle"});
-                    std::printf(" %.3f s (exit %d) | %.0f | %.2f |", nv.seconds, nv.exit_code,
-                                nv.peak_mib, s.seconds / nv.seconds);
+                    std::printf(" %.3f s (cpu %.3f s, exit %d) | %.0f | %.2f |", nv.seconds,
+                                nv.cpu_seconds, nv.exit_code, nv.peak_mib, s.seconds / nv.seconds);
                 }
                 std::printf("\n");
                 std::fflush(stdout);
