@@ -155,9 +155,10 @@ int main(int argc, char** argv) {
             const CheckReport report = check_scene(read);
             const double check_s = now() - t;
             const ProcessRun cli = run_process({strata, "check", path});
-            std::printf("| %s | %.3f s | %.3f s (%s) | %.3f s (exit %d) | %.0f |\n", label.c_str(),
-                        read_s, check_s, report.is_collision_free() ? "clean" : "NOT clean",
-                        cli.seconds, cli.exit_code, cli.peak_mib);
+            std::printf("| %s | %.3f s | %.3f s (%s) | %.3f s (cpu %.3f s, exit %d) | %.0f |\n",
+                        label.c_str(), read_s, check_s,
+                        report.is_collision_free() ? "clean" : "NOT clean", cli.seconds,
+                        cli.cpu_seconds, cli.exit_code, cli.peak_mib);
             std::fflush(stdout);
         }
         std::printf(
