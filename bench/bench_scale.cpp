@@ -8,7 +8,8 @@
 // at every size) is written as JSON into DIR; then, in one run,
 //   - library calls in this process: read_scene, check_scene (one core);
 //   - whole processes (fork + exec, wall time, the child's CPU time (user + system, which a
-//     busy machine disturbs less) and its peak resident memory):
+//     busy machine disturbs less) and its peak resident memory, which includes what this
+//     process holds when it forks: scenes are freed and malloc_trim()med first):
 //     `strata check IN`, and for every R `strata simplify IN -o OUT --remove R` and the same
 //     with `--no-untangle` (naive decimation, the floor any simplifier pays).
 // Plain timers, one run per cell: the machine is small and noisy, read ratios.
@@ -16,6 +17,7 @@
 #include "strata/io/scene_io.h"
 #include "strata/simplify/simplify.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -141,23 +143,26 @@ int main(int argc, char** argv) {
         std::vector<Row> rows;
         for (double n : points) {
             const auto count = static_cast<std::size_t>(n);
-            const Scene scene = folded_stack(layers, count, 10.0 * n / 600.0);
             const std::string label = std::to_string(layers) + " x " + std::to_string(count);
             const std::string path =
                 dir + "/stack_" + std::to_string(layers) + "x" + std::to_string(count) + ".json";
-            write_scene(scene, path);
             rows.push_back({label, path});
-
-            double t = now();
-            const Scene read = read_scene(path);
-            const double read_s = now() - t;
-            t = now();
-            const CheckReport report = check_scene(read);
-            const double check_s = now() - t;
+            double read_s = 0.0, check_s = 0.0;
+            bool clean = false;
+            {
+                write_scene(folded_stack(layers, count, 10.0 * n / 600.0), path);
+                double t = now();
+                const Scene read = read_scene(path);
+                read_s = now() - t;
+                t = now();
+                clean = check_scene(read).is_collision_free();
+                check_s = now() - t;
+            }
+            // A forked child starts with our resident pages in its peak: give them back first.
+            malloc_trim(0);
             const ProcessRun cli = run_process({strata, "check", path});
             std::printf("| %s | %.3f s | %.3f s (%s) | %.3f s (cpu %.3f s, exit %d) | %.0f |\n",
-                        label.c_str(), read_s, check_s,
-                        report.is_collision_free() ? "clean" : "NOT clean", cli.seconds,
+                        label.c_str(), read_s, check_s, clean ? "clean" : "NOT clean", cli.seconds,
                         cli.cpu_seconds, cli.exit_code, cli.peak_mib);
             std::fflush(stdout);
         }
