@@ -84,6 +84,15 @@ py::object to_python(const nlohmann::json& j) {
     return py::module_::import("json").attr("loads")(j.dump());
 }
 
+// A count option: a whole number >= `min` (as the CLI's add_count_option()).
+std::size_t whole(const py::handle& v, const char* name, std::size_t min) {
+    const auto x = v.cast<long long>();
+    if (x < static_cast<long long>(min))
+        throw InvalidInput(std::string("simplify: ") + name + " must be a whole number >= " +
+                           std::to_string(min) + " (got " + std::to_string(x) + ")");
+    return static_cast<std::size_t>(x);
+}
+
 // The simplify options from the keyword arguments (names as in strata.simplify()).
 cli::SimplifyOptions simplify_options(const py::dict& kw) {
     cli::SimplifyOptions o;
@@ -96,7 +105,7 @@ cli::SimplifyOptions simplify_options(const py::dict& kw) {
         if (key == "remove")
             p.remove = v.cast<double>();
         else if (key == "keep")
-            p.keep = v.cast<std::size_t>();
+            p.keep = whole(v, "keep", 0);
         else if (key == "max_error")
             p.max_error = v.cast<double>();
         else if (key == "decimator")
@@ -104,9 +113,9 @@ cli::SimplifyOptions simplify_options(const py::dict& kw) {
         else if (key == "seed")
             p.seed = v.cast<std::uint64_t>();
         else if (key == "untangle_batch")
-            p.batch = v.cast<std::size_t>();
+            p.batch = whole(v, "untangle_batch", 1);
         else if (key == "n_out")
-            p.n_out = v.cast<std::size_t>();
+            p.n_out = whole(v, "n_out", 0);
         else if (key == "schedule") {
             const std::string s = v.cast<std::string>();
             if (s == "deferred")
@@ -203,8 +212,8 @@ PYBIND11_MODULE(_strata, m) {
                          double weight, std::optional<double> alpha, std::optional<double> beta,
                          std::optional<std::vector<std::string>> outer) {
                  Layer l;
+                 l.points = to_points(points, name.empty() ? "layer" : "layer '" + name + "'");
                  l.name = std::move(name);
-                 l.points = to_points(points, name.empty() ? "layer" : "layer '" + l.name + "'");
                  l.closed = closed;
                  l.thickness = thickness;
                  l.weight = weight;

@@ -27,16 +27,34 @@ import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _strata
 
 __all__ = ["BatchResult", "simplify_folder", "main"]
 
 
-def _run_slice(input_path: str, output_path: str, options: Dict[str, Any]) -> Dict[str, Any]:
-    """The task of one slice (runs on a worker; never raises for a slice that fails)."""
-    return _strata._batch_slice(input_path, output_path, options)
+def _run_slice(input_path: Tuple[str, str], output_path: Tuple[str, str], options: Dict[str, Any]) -> Dict[str, Any]:
+    """The task of one slice (runs on a worker; never raises for a slice that fails).
+
+    The paths are absolute (a worker's working folder is not the client's); the messages, the
+    table row and the report entry name them as the client gave them, as the CLI does."""
+    given_in, abs_in = input_path
+    given_out, abs_out = output_path
+    r = _strata._batch_slice(abs_in, abs_out, options)
+
+    def relabel(text):
+        return text.replace(abs_in, given_in).replace(abs_out, given_out)
+
+    r["input"], r["output"] = given_in, given_out
+    r["row"] = relabel(r["row"])
+    if r["error"] is not None:
+        r["error"] = relabel(r["error"])
+    entry = r["entry"]
+    for key in ("input", "output", "error"):
+        if key in entry:
+            entry[key] = relabel(entry[key])
+    return r
 
 
 def _failed_row(input_path: str, message: str) -> str:
@@ -117,7 +135,12 @@ def simplify_folder(
         for i, path in enumerate(files):
             out = _strata._batch_output(output, path)
             f = client.submit(
-                _run_slice, path, out, options, pure=False, key=f"strata-slice-{i}-{os.path.basename(path)}"
+                _run_slice,
+                (path, os.path.abspath(path)),
+                (out, os.path.abspath(out)),
+                options,
+                pure=False,
+                key=f"strata-slice-{i}-{os.path.basename(path)}",
             )
             futures[f] = i
         rows: List[Optional[Dict[str, Any]]] = [None] * len(files)

@@ -89,7 +89,7 @@ def test_a_task_that_dies_is_one_failed_line(client, slices_copy, tmp_path, monk
     real = strata.batch._run_slice
 
     def flaky(input_path, output_path, options):
-        if input_path.endswith("y-0.15.json"):
+        if input_path[0].endswith("y-0.15.json"):
             raise MemoryError("worker ran out of memory")
         return real(input_path, output_path, options)
 
@@ -99,3 +99,67 @@ def test_a_task_that_dies_is_one_failed_line(client, slices_copy, tmp_path, monk
     line = [l for l in result.table.splitlines() if "FAILED" in l]
     assert len(line) == 1 and "y-0.15.json" in line[0] and "MemoryError" in line[0]
     assert result.exit_code == 1
+
+
+def test_relative_paths_name_the_files_as_given(cli, client, slices_copy, tmp_path, monkeypatch):
+    # the CLI's messages name the input as given; a worker's working folder may differ
+    shutil.copy(DATA / "bad" / "syntax_error.json", slices_copy / "broken.json")
+    monkeypatch.chdir(tmp_path)
+    code, table = run_cli(cli, ["slices"], "cli")
+    result = strata.batch.simplify_folder("slices", "dask", client=client)
+    assert comparable(result.table) == comparable(table)
+    [failed] = [r for r in result.rows if r["error"]]
+    assert failed["error"].startswith("slices/broken.json:")
+    assert failed["entry"]["input"] == "slices/broken.json"
+    ok = [r for r in result.rows if not r["error"]]
+    assert ok[0]["entry"]["output"].startswith("dask/")
+
+
+def free_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_scheduler_address_with_worker_processes_elsewhere(cli, slices_copy, tmp_path, monkeypatch):
+    """A scheduler and 2 worker processes started as on a cluster (their own working folder),
+    reached by address through `python -m strata.batch --scheduler`; relative paths."""
+    import sys
+    import time
+
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    log = open(tmp_path / "dask.log", "w")
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host",
+                               "127.0.0.1", "--port", str(port), "--dashboard-address", ":0"],
+                              cwd=elsewhere, stdout=log, stderr=log)]
+    try:
+        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
+                                       "--nworkers", "2", "--nthreads", "1", "--dashboard-address",
+                                       ":0"], cwd=elsewhere, stdout=log, stderr=log))
+        with Client(address, timeout=60) as c:
+            c.wait_for_workers(2, timeout=60)
+            assert len(c.scheduler_info()["workers"]) == 2
+        monkeypatch.chdir(tmp_path)
+        code, table = run_cli(cli, ["slices"], "cli")
+        start = time.perf_counter()
+        run = subprocess.run([sys.executable, "-m", "strata.batch", "slices", "-o", "dask",
+                              "--scheduler", address], capture_output=True, text=True, timeout=300)
+        assert time.perf_counter() - start < 300
+        assert run.returncode == code == 0, run.stderr
+        assert comparable(run.stdout) == comparable(table)
+        for f in (tmp_path / "cli").iterdir():
+            assert (tmp_path / "dask" / f.name).read_bytes() == f.read_bytes(), f.name
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in reversed(procs):
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        log.close()

@@ -203,3 +203,13 @@ def test_simplify_releases_the_gil():
     assert elapsed > 0.1, "the scene is too small to tell"
     # with the GIL held the other thread could not tick at all during the call
     assert during >= 0.2 * elapsed / 0.0011, (during, elapsed)
+
+
+def test_counts_must_be_whole_numbers():
+    scene = strata.read_scene(SLICES / "mh_elegantsuit01_y+0.50.json")
+    with pytest.raises(strata.InvalidInput, match=r"keep must be a whole number >= 0 \(got -1\)"):
+        strata.simplify(scene, keep=-1)
+    with pytest.raises(strata.InvalidInput, match=r"untangle_batch must be a whole number >= 1"):
+        strata.simplify(scene, untangle_batch=0)
+    with pytest.raises(strata.InvalidInput, match="layer 'named'"):
+        strata.Layer(np.zeros((3, 3)), name="named")
