@@ -43,9 +43,13 @@ def main():
         out = os.path.join(work, "cli")
         shutil.rmtree(out, ignore_errors=True)
         t = time.perf_counter()
-        subprocess.run([a.cli, "simplify", src, "-o", out], check=True, capture_output=True)
+        run = subprocess.run([a.cli, "simplify", src, "-o", out], capture_output=True)
+        if run.returncode not in (0, 1):
+            sys.exit(run.stderr.decode())
+        cli_code[0] = run.returncode
         return time.perf_counter() - t
 
+    cli_code = [0]
     cli = min(cli_run() for _ in range(a.repeat))
     print(f"CLI (TBB, all cores): {cli:.3f} s, {1000 * cli / n:.2f} ms per slice")
     for processes in (True, False):
@@ -61,9 +65,9 @@ def main():
                 t = time.perf_counter()
                 r = strata.batch.simplify_folder(src, out, client=client)
                 dt = time.perf_counter() - t
-                assert r.exit_code == 0, r.table
+                assert r.exit_code == cli_code[0], r.table
                 best = dt if best is None else min(best, dt)
-            same = all(filecmp.cmp(os.path.join(work, "cli", f), os.path.join(out, f), shallow=False)
+            same = sorted(os.listdir(os.path.join(work, "cli"))) == sorted(os.listdir(out)) and all(filecmp.cmp(os.path.join(work, "cli", f), os.path.join(out, f), shallow=False)
                        for f in os.listdir(os.path.join(work, "cli")))
             kind = "processes" if processes else "threads"
             print(f"Dask, 2 workers ({kind}): {best:.3f} s, {1000 * best / n:.2f} ms per slice; "
