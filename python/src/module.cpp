@@ -26,8 +26,10 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace py = pybind11;
@@ -175,6 +177,32 @@ py::dict outcome_dict(const cli::Outcome& o) {
     d["peak_memory_mib"] = cli::peak_memory_mib();
     return d;
 }
+
+// A ProgressFn calling the Python callable `fn(stage, fraction)` (with the GIL) when it is not
+// None: a false return cancels (strata.Cancelled); an exception it raises (or a pending
+// KeyboardInterrupt) cancels too and is raised again by rethrow_if_any() once the work stopped.
+struct PythonProgress {
+    py::object fn;
+    std::shared_ptr<py::error_already_set> error;
+
+    ProgressFn callback() {
+        if (fn.is_none()) return {};
+        return [this](std::string_view stage, double fraction) {
+            py::gil_scoped_acquire acquire;
+            if (error) return false;
+            try {
+                if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+                return py::cast<bool>(fn(std::string(stage), fraction));
+            } catch (py::error_already_set& e) {
+                error = std::make_shared<py::error_already_set>(std::move(e));
+                return false;
+            }
+        };
+    }
+    void rethrow_if_any() {
+        if (error) throw *error;
+    }
+};
 
 // A grid of a layer's field, row j from the top (y = ymax - (j + 0.5) h), column i from the left.
 struct FieldGrid {
@@ -366,7 +394,8 @@ PYBIND11_MODULE(_strata, m) {
 
     // _simplify(scene, options) -> (scene, report, naive report or None, input untangling
     // as a dict or None); the options are strata.simplify()'s keyword arguments.
-    m.def("_simplify", [](const Scene& scene, const py::dict& kw) {
+    m.def("_simplify", [](const Scene& scene, const py::dict& kw, const py::object& progress) {
+        PythonProgress python_progress{progress, nullptr};
         const cli::SimplifyOptions opt = simplify_options(kw);
         if (opt.input_crossings == cli::InputCrossings::Skip)
             throw InvalidInput(
@@ -380,7 +409,13 @@ PYBIND11_MODULE(_strata, m) {
             const Scene input = cli::with_default_thickness(scene, opt.thickness);
             const std::optional<Scene> prepared =
                 cli::prepare_input(input, "simplify", opt.input_crossings, opt.params, untangled);
-            out = cli::run_one(*prepared, opt, {}, result, nullptr);
+            try {
+                out = cli::run_one(*prepared, opt, python_progress.callback(), result, nullptr);
+            } catch (const Cancelled&) {
+                py::gil_scoped_acquire acquire;
+                python_progress.rethrow_if_any();
+                throw;
+            }
         }
         return py::make_tuple(
             result, *out.report, out.naive ? py::cast(*out.naive) : py::object(py::none()),
@@ -401,7 +436,8 @@ PYBIND11_MODULE(_strata, m) {
             return r.seconds_fields + r.seconds_untangle + r.seconds_finish + r.seconds_check;
         });
 
-    m.def("_untangle", [](const Scene& scene, const py::dict& kw) {
+    m.def("_untangle", [](const Scene& scene, const py::dict& kw, const py::object& progress) {
+        PythonProgress python_progress{progress, nullptr};
         UntangleParams u;
         for (const auto& item : kw) {
             const std::string key = py::str(item.first);
@@ -433,7 +469,13 @@ PYBIND11_MODULE(_strata, m) {
         UntangleReport r;
         {
             py::gil_scoped_release release;
-            r = untangle(out, u);
+            try {
+                r = untangle(out, u, python_progress.callback());
+            } catch (const Cancelled&) {
+                py::gil_scoped_acquire acquire;
+                python_progress.rethrow_if_any();
+                throw;
+            }
         }
         return py::make_tuple(out, r);
     });

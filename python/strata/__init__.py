@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -159,6 +159,7 @@ def simplify(
     shape_matching: bool = True,
     finish: bool = True,
     input_crossings: str = "untangle",
+    progress: Optional[Callable[[str, float], bool]] = None,
 ) -> Tuple[Scene, SimplifyReport]:
     """Collision-free simplification, as ``strata simplify IN -o OUT`` (same defaults).
 
@@ -190,6 +191,9 @@ def simplify(
       finish: False = no finishing stage (``--no-finish``).
       input_crossings: an input that already crosses is untangled first ("untangle",
         default) or refused ("fail": :class:`InvalidInput` naming the first crossing).
+      progress: called as progress("simplify", fraction of the removals done) from the
+        computing thread (with the GIL); returning False cancels (:class:`Cancelled`, nothing
+        returned); an exception it raises, or Ctrl-C, stops the work and is raised.
 
     Raises :class:`InvalidInput` (a parameter out of range, with the CLI's message).
     """
@@ -218,6 +222,7 @@ def simplify(
             finish=finish,
             input_crossings=input_crossings,
         ),
+        progress,
     )
     return result, report
 
@@ -234,12 +239,14 @@ def untangle(
     max_passes: Optional[int] = None,
     shape_matching: bool = True,
     finish: bool = True,
+    progress: Optional[Callable[[str, float], bool]] = None,
 ) -> Tuple[Scene, UntangleReport]:
     """Untangles a scene that already crosses (the global mode of ``strata untangle``): every
     vertex may move. Returns ``(untangled scene, report)``; ``report.collision_free`` tells
     whether the result is clean (no crossing, nesting kept, gaps >= 0.9 x required).
     Defaults are the library's: alpha 0.8, beta 0.9, gradient_steps 10, tolerance 1e-6
-    (relative to the scene diagonal), max_rounds 1, max_passes 64."""
+    (relative to the scene diagonal), max_rounds 1, max_passes 64. ``progress``: as in
+    :func:`simplify`, called once per round ("untangle", fraction)."""
     return _strata._untangle(
         scene,
         dict(
@@ -253,6 +260,7 @@ def untangle(
             shape_matching=shape_matching,
             finish=finish,
         ),
+        progress,
     )
 
 

@@ -3,7 +3,7 @@ strata: it re-exports the classes below and wraps the private functions (leading
 with keyword arguments, defaults and documentation."""
 
 import os
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -151,9 +151,11 @@ class UntangleReport:
 def read_scene(path: Union[str, os.PathLike[str]]) -> Scene: ...
 def write_scene(scene: Scene, path: Union[str, os.PathLike[str]]) -> None: ...
 def _simplify(
-    scene: Scene, options: Dict[str, Any]
+    scene: Scene, options: Dict[str, Any], progress: Optional[Callable[[str, float], bool]]
 ) -> Tuple[Scene, SimplifyReport, Optional[SimplifyReport], Optional[Dict[str, Any]]]: ...
-def _untangle(scene: Scene, options: Dict[str, Any]) -> Tuple[Scene, UntangleReport]: ...
+def _untangle(
+    scene: Scene, options: Dict[str, Any], progress: Optional[Callable[[str, float], bool]]
+) -> Tuple[Scene, UntangleReport]: ...
 def _check(
     scene: Scene,
     reference: Optional[Scene],

@@ -213,3 +213,19 @@ def test_counts_must_be_whole_numbers():
         strata.simplify(scene, untangle_batch=0)
     with pytest.raises(strata.InvalidInput, match="layer 'named'"):
         strata.Layer(np.zeros((3, 3)), name="named")
+
+
+def test_progress_reports_and_cancels():
+    scene = folded_stack(points=2000)
+    seen = []
+    strata.simplify(scene, progress=lambda stage, f: seen.append((stage, f)) or True)
+    assert seen and seen[0][0] == "simplify" and all(0 <= f <= 1 for _, f in seen)
+    assert [f for _, f in seen] == sorted(f for _, f in seen)
+    with pytest.raises(strata.Cancelled):
+        strata.simplify(scene, progress=lambda stage, f: f < 0.3)
+
+    def boom(stage, f):
+        raise KeyError("from the callback")
+
+    with pytest.raises(KeyError, match="from the callback"):
+        strata.simplify(scene, progress=boom)
