@@ -614,7 +614,6 @@ PYBIND11_MODULE(_strata, m) {
         return out;
     });
 
-    py::class_<FieldGrid>(m, "_FieldGrid");
     m.def("_sample_field", [](const Scene& scene, std::size_t layer, double spacing,
                               std::optional<std::vector<double>> box, const std::string& backend,
                               double voxel_size, double band_width, double margin) {

@@ -244,8 +244,12 @@ def untangle(
     """Untangles a scene that already crosses (the global mode of ``strata untangle``): every
     vertex may move. Returns ``(untangled scene, report)``; ``report.collision_free`` tells
     whether the result is clean (no crossing, nesting kept, gaps >= 0.9 x required).
-    Defaults are the library's: alpha 0.8, beta 0.9, gradient_steps 10, tolerance 1e-6
-    (relative to the scene diagonal), max_rounds 1, max_passes 64. ``progress``: as in
+    Parameters (``strata untangle``'s options; None: the library's default): ``backend``
+    "indexed" (default), "exact" or "grid"; ``alpha`` 0.8 and ``beta`` 0.9 (shape matching,
+    [0, 1]); ``gradient_steps`` 10; ``tolerance`` 1e-6 (relative to the scene diagonal);
+    ``max_rounds`` 1 per pass; ``max_passes`` 64; ``shape_matching`` (default True; False =
+    pure projection); ``finish`` (default True; False = no finishing stage, the paper's
+    untangling alone). ``progress``: as in
     :func:`simplify`, called once per round ("untangle", fraction)."""
     return _strata._untangle(
         scene,

@@ -201,8 +201,9 @@ def test_simplify_releases_the_gil():
     stop.set()
     thread.join()
     assert elapsed > 0.1, "the scene is too small to tell"
-    # with the GIL held the other thread could not tick at all during the call
-    assert during >= 0.2 * elapsed / 0.0011, (during, elapsed)
+    # with the GIL held the other thread could not tick during the call (at most once at its
+    # edges); released, it ticks about every millisecond (fewer on a loaded machine)
+    assert during >= 10, (during, elapsed)
 
 
 def test_counts_must_be_whole_numbers():
