@@ -555,15 +555,24 @@ PYBIND11_MODULE(_strata, m) {
         p.weld.enabled = weld;
         p.weld.tolerance = weld_tolerance;
         validate(p);
-        // Each mesh: a path, or a tuple (name, vertices (n, 3), faces (m, k)).
+        // Each mesh: a path, (name, path), or (name, vertices (n, 3), faces (m, k)).
         std::vector<std::filesystem::path> paths;
         std::vector<SliceMesh> loaded;
+        std::vector<std::string> names;  // of the meshes read from `paths`
         std::vector<int> is_path;
         for (const py::handle& item : meshes) {
             if (py::isinstance<py::tuple>(item)) {
                 const auto t = item.cast<py::tuple>();
+                if (t.size() == 2) {  // (name, path)
+                    names.push_back(t[0].cast<std::string>());
+                    paths.push_back(t[1].cast<std::filesystem::path>());
+                    loaded.emplace_back();
+                    is_path.push_back(static_cast<int>(loaded.size() - 1));
+                    continue;
+                }
                 if (t.size() != 3)
-                    throw InvalidInput("slice: a mesh is a path or (name, vertices, faces)");
+                    throw InvalidInput(
+                        "slice: a mesh is a path, (name, path) or (name, vertices, faces)");
                 const std::string name = t[0].cast<std::string>();
                 const auto v =
                     py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t[1]);
@@ -597,6 +606,7 @@ PYBIND11_MODULE(_strata, m) {
                 loaded.push_back(make_slice_mesh(name, std::move(vertices), faces));
             } else {
                 paths.push_back(item.cast<std::filesystem::path>());
+                names.emplace_back();  // the file stem
                 loaded.emplace_back();
                 is_path.push_back(static_cast<int>(loaded.size() - 1));
             }
@@ -605,7 +615,7 @@ PYBIND11_MODULE(_strata, m) {
         {
             py::gil_scoped_release release;
             for (std::size_t k = 0; k < paths.size(); ++k)
-                loaded[static_cast<std::size_t>(is_path[k])] = read_slice_mesh(paths[k]);
+                loaded[static_cast<std::size_t>(is_path[k])] = read_slice_mesh(paths[k], names[k]);
             report = slice_meshes(loaded, p);
         }
         py::list out;

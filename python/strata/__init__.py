@@ -309,7 +309,9 @@ def check(
 
 
 def slice(  # noqa: A001 - the verb's name
-    meshes: Sequence[Union[PathLike, Tuple[str, np.ndarray, np.ndarray]]],
+    meshes: Sequence[
+        Union[PathLike, Tuple[str, PathLike], Tuple[str, np.ndarray, np.ndarray]]
+    ],
     at: Union[float, Sequence[float]],
     *,
     axis: str = "y",
@@ -324,7 +326,7 @@ def slice(  # noqa: A001 - the verb's name
     """Planar slices of garment meshes with their nesting (``strata slice``).
 
     ``meshes``: paths (OBJ/OFF/PLY/STL, read through OpenMesh; the layer names start with the
-    file stem) or tuples ``(name, vertices, faces)`` with vertices an (n, 3) float array and
+    file stem), tuples ``(name, path)`` (the CLI's ``name=path``) or tuples ``(name, vertices, faces)`` with vertices an (n, 3) float array and
     faces an (m, k >= 3) integer array of vertex indices. ``at``: one height or several, mesh
     units along ``axis`` ("x", "y" or "z"). Returns one scene per height (None where the plane
     misses every mesh). ``components``: name layers after their connected component;
@@ -332,7 +334,11 @@ def slice(  # noqa: A001 - the verb's name
     ``mesh_thickness`` per mesh name; ``weld`` (default True) joins open pieces that meet at a
     seam within ``weld_tolerance`` (mesh units; 0 = automatic, 5% of the median edge)."""
     heights = [float(at)] if np.isscalar(at) else [float(h) for h in at]
-    items = [m if isinstance(m, tuple) else os.fspath(m) for m in meshes]
+    items = [
+        (m[0], os.fspath(m[1])) if isinstance(m, tuple) and len(m) == 2
+        else m if isinstance(m, tuple) else os.fspath(m)
+        for m in meshes
+    ]
     return _strata._slice(
         items,
         axis,

@@ -230,3 +230,20 @@ def test_progress_reports_and_cancels():
 
     with pytest.raises(KeyError, match="from the callback"):
         strata.simplify(scene, progress=boom)
+
+
+GARMENTS = DATA.parents[2] / "shared" / "data" / "garments" / "makehuman"
+
+
+@pytest.mark.skipif(not GARMENTS.is_dir(), reason="no ../shared/data/garments beside the project")
+def test_slice_of_a_real_outfit_matches_the_cli(cli, tmp_path):
+    body, suit = GARMENTS / "male_generic.obj", GARMENTS / "male_casualsuit03.obj"
+    subprocess.run([cli, "slice", f"body={body}", f"suit={suit}", "--order", "body,suit",
+                    "--units", "dm", "--at", "1.5", "-o", str(tmp_path / "cli.json")],
+                   check=True, capture_output=True)
+    [scene] = strata.slice([("body", body), ("suit", suit)], at=1.5, order=["body", "suit"],
+                           units="dm")
+    strata.write_scene(scene, tmp_path / "py.json")
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert any(n.startswith("body_") for n in scene.names)
+    assert any(n.startswith("suit_") for n in scene.names)
