@@ -3,15 +3,17 @@
     python bench/dask_batch.py build/tools/strata tests/data/slices [--copies 10] [--repeat 3]
 
 Both run on the same slices (the folder's files, each copied `copies` times under new names
-so that there is enough work); the CLI with all cores, Dask on a LocalCluster of 2 workers of
-one thread (processes, then threads), started before the clock. Prints the wall times, the
-overhead per slice ((dask - cli) / slices) and checks that both wrote the same files.
+so that there is enough work); the CLI with all cores, Dask on LocalClusters of 2 workers of
+one thread (processes; threads), started before the clock; the runs are interleaved. Prints
+the median wall times, the overhead per slice ((dask - cli) / slices) and checks that both
+wrote the same files.
 """
 
 import argparse
 import filecmp
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -37,7 +39,7 @@ def main():
         for f in files:
             shutil.copy(os.path.join(a.folder, f), os.path.join(src, f"c{k:03d}_{f}"))
     n = len(files) * a.copies
-    print(f"{n} slices ({len(files)} files x {a.copies} copies), best of {a.repeat}")
+    print(f"{n} slices ({len(files)} files x {a.copies} copies), {a.repeat} interleaved runs")
 
     def cli_run():
         out = os.path.join(work, "cli")
@@ -50,29 +52,50 @@ def main():
         return time.perf_counter() - t
 
     cli_code = [0]
-    cli = min(cli_run() for _ in range(a.repeat))
-    print(f"CLI (TBB, all cores): {cli:.3f} s, {1000 * cli / n:.2f} ms per slice")
-    for processes in (True, False):
+
+    def dask_run(client):
+        out = os.path.join(work, "dask")
+        shutil.rmtree(out, ignore_errors=True)
         t = time.perf_counter()
-        with LocalCluster(n_workers=2, threads_per_worker=1, processes=processes,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
-            client.submit(lambda: 0).result()  # workers up
-            startup = time.perf_counter() - t
-            best = None
-            for _ in range(a.repeat):
-                out = os.path.join(work, "dask")
-                shutil.rmtree(out, ignore_errors=True)
-                t = time.perf_counter()
-                r = strata.batch.simplify_folder(src, out, client=client)
-                dt = time.perf_counter() - t
-                assert r.exit_code == cli_code[0], r.table
-                best = dt if best is None else min(best, dt)
-            same = sorted(os.listdir(os.path.join(work, "cli"))) == sorted(os.listdir(out)) and all(filecmp.cmp(os.path.join(work, "cli", f), os.path.join(out, f), shallow=False)
-                       for f in os.listdir(os.path.join(work, "cli")))
-            kind = "processes" if processes else "threads"
-            print(f"Dask, 2 workers ({kind}): {best:.3f} s, {1000 * best / n:.2f} ms per slice; "
-                  f"overhead {1000 * (best - cli) / n:+.2f} ms per slice; cluster start {startup:.2f} s; "
-                  f"outputs identical: {same}")
+        r = strata.batch.simplify_folder(src, out, client=client)
+        dt = time.perf_counter() - t
+        assert r.exit_code == cli_code[0], r.table
+        same = sorted(os.listdir(os.path.join(work, "cli"))) == sorted(os.listdir(out)) and all(
+            filecmp.cmp(os.path.join(work, "cli", f), os.path.join(out, f), shallow=False)
+            for f in os.listdir(os.path.join(work, "cli")))
+        return dt, same
+
+    # Both clusters stay up; the runs are interleaved (CLI, Dask processes, Dask threads) so
+    # that the load of a shared machine falls on all three alike.
+    clusters, starts = {}, {}
+    for kind in ("processes", "threads"):
+        t = time.perf_counter()
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=kind == "processes",
+                               dashboard_address=None)
+        client = Client(cluster)
+        client.submit(lambda: 0).result()  # workers up
+        starts[kind] = time.perf_counter() - t
+        clusters[kind] = (cluster, client)
+    times = {"cli": [], "processes": [], "threads": []}
+    identical = True
+    for _ in range(a.repeat):
+        times["cli"].append(cli_run())
+        for kind in ("processes", "threads"):
+            dt, same = dask_run(clusters[kind][1])
+            times[kind].append(dt)
+            identical = identical and same
+    for cluster, client in clusters.values():
+        client.close()
+        cluster.close()
+    med = {k: statistics.median(v) for k, v in times.items()}
+    print(f"CLI (TBB, all cores): median {med['cli']:.3f} s (best {min(times['cli']):.3f}), "
+          f"{1000 * med['cli'] / n:.2f} ms per slice")
+    for kind in ("processes", "threads"):
+        print(f"Dask, 2 workers ({kind}): median {med[kind]:.3f} s (best {min(times[kind]):.3f}), "
+              f"{1000 * med[kind] / n:.2f} ms per slice; overhead "
+              f"{1000 * (med[kind] - med['cli']) / n:+.2f} ms per slice (medians); cluster start "
+              f"{starts[kind]:.2f} s")
+    print(f"outputs identical to the CLI's in every run: {identical}")
     shutil.rmtree(work)
     return 0
 
