@@ -519,6 +519,36 @@ TEST_CASE("localized updates equal a full rebuild", "[field]") {
     }
 }
 
+TEST_CASE("indexed field: a vertex carried far away keeps memory bounded and answers exact",
+          "[field]") {
+    // A runaway vertex (seen in an untangling of a rolled scene) made one segment span 1e8
+    // buckets: it now goes to the index's plain list instead of the buckets.
+    std::mt19937 rng(5);
+    Layer layer = random_star(rng, 200, false);
+    const Scene scene({layer});
+    ResolvedFieldParams p = resolve({}, scene);
+    p.bucket_size = 0.01;
+    auto brute = make_field(layer, 1, with_backend(p, FieldBackend::ExactBrute));
+    auto indexed = make_field(layer, 1, with_backend(p, FieldBackend::ExactIndexed));
+    const std::size_t before = indexed->stats().memory_bytes;
+    for (const Vec2& far : {Vec2(1e6, 3e5), Vec2(-2e6, 1e6), Vec2(0.5, 0.5)}) {
+        layer.points[7] = far;
+        const PolylineEdit edit{7, 1, 1};
+        brute->update(layer.points, edit);
+        indexed->update(layer.points, edit);
+        CHECK(indexed->stats().memory_bytes < 2 * before + 4096);
+        std::uniform_real_distribution<double> u(-3.0, 5.0);
+        std::size_t differ = 0;
+        for (int q = 0; q < 500; ++q) {
+            Vec2 x(u(rng), u(rng));
+            if (q % 50 == 0) x = 0.5 * far + Vec2(u(rng), u(rng));  // near the long segments
+            const FieldSample a = brute->sample(x), b = indexed->sample(x);
+            if (a.value != b.value || a.gradient != b.gradient || a.border != b.border) ++differ;
+        }
+        CHECK(differ == 0);
+    }
+}
+
 TEST_CASE("the blocked slot sequence splices like a vector", "[field]") {
     // Enough entries for several blocks; edits that empty blocks, split them and touch the ends.
     detail::SlotSequence seq;

@@ -14,6 +14,12 @@ std::uint64_t cell_key(long i, long j) {
 
 }  // namespace
 
+bool SegmentIndex::is_large(const Box2& box) const {
+    const double columns = std::floor(box.max.x / cell_) - std::floor(box.min.x / cell_) + 1.0;
+    const double rows = std::floor(box.max.y / cell_) - std::floor(box.min.y / cell_) + 1.0;
+    return !(columns * rows <= kMaxCells);  // NaN too
+}
+
 long SegmentIndex::cell_of(double v) const {
     return static_cast<long>(std::floor(v / cell_));
 }
@@ -26,6 +32,7 @@ void SegmentIndex::for_cells(const Box2& box, F&& f) const {
 
 void SegmentIndex::build(const SegmentStore& store) {
     buckets_.clear();
+    large_.clear();
     imin_ = jmin_ = std::numeric_limits<long>::max();
     imax_ = jmax_ = std::numeric_limits<long>::min();
     for (std::uint32_t s = 0; s < store.segments().size(); ++s) insert(store, s);
@@ -34,6 +41,10 @@ void SegmentIndex::build(const SegmentStore& store) {
 void SegmentIndex::insert(const SegmentStore& store, std::uint32_t slot) {
     const Segment& s = store.segments()[slot];
     if (!s.live) return;
+    if (is_large(s.box())) {
+        large_.push_back(slot);
+        return;
+    }
     for_cells(s.box(), [&](long i, long j) {
         buckets_[cell_key(i, j)].push_back(slot);
         imin_ = std::min(imin_, i);
@@ -44,6 +55,10 @@ void SegmentIndex::insert(const SegmentStore& store, std::uint32_t slot) {
 }
 
 void SegmentIndex::erase(const SegmentStore& store, std::uint32_t slot) {
+    if (is_large(store.segments()[slot].box())) {
+        large_.erase(std::remove(large_.begin(), large_.end(), slot), large_.end());
+        return;
+    }
     for_cells(store.segments()[slot].box(), [&](long i, long j) {
         const auto it = buckets_.find(cell_key(i, j));
         if (it == buckets_.end()) return;
@@ -62,6 +77,7 @@ void SegmentIndex::visit(const SegmentStore& store, const Vec2& x, long i, long 
 
 void SegmentIndex::search(const SegmentStore& store, const Vec2& x, Nearest& best,
                           double limit) const {
+    for (std::uint32_t s : large_) store.offer(x, s, best);
     if (imin_ > imax_) return;
     const long ci = cell_of(x.x), cj = cell_of(x.y);
     const long start = std::max({imin_ - ci, ci - imax_, jmin_ - cj, cj - jmax_, 0L});
@@ -91,7 +107,8 @@ void SegmentIndex::search(const SegmentStore& store, const Vec2& x, Nearest& bes
 
 void SegmentIndex::candidates(const Box2& box, std::vector<std::uint32_t>& out) const {
     out.clear();
-    if (imin_ > imax_) return;
+    for (std::uint32_t s : large_) out.push_back(s);
+    if (imin_ > imax_ && out.empty()) return;
     const long i0 = std::max(cell_of(box.min.x), imin_), i1 = std::min(cell_of(box.max.x), imax_);
     const long j0 = std::max(cell_of(box.min.y), jmin_), j1 = std::min(cell_of(box.max.y), jmax_);
     for (long i = i0; i <= i1; ++i)
@@ -105,7 +122,8 @@ void SegmentIndex::candidates(const Box2& box, std::vector<std::uint32_t>& out) 
 
 std::size_t SegmentIndex::memory_bytes() const {
     // One node per bucket: key, slot vector and the node's next pointer.
-    std::size_t bytes = buckets_.bucket_count() * sizeof(void*);
+    std::size_t bytes =
+        buckets_.bucket_count() * sizeof(void*) + large_.capacity() * sizeof(std::uint32_t);
     for (const auto& [key, ids] : buckets_)
         bytes += sizeof(key) + sizeof(ids) + sizeof(void*) + ids.capacity() * sizeof(std::uint32_t);
     return bytes;

@@ -13,7 +13,9 @@
 namespace strata::detail {
 
 /// Square buckets of side `cell` (scene units) listing the live slots whose bounding box
-/// touches them. The store is not owned: pass the same one to every call.
+/// touches them; a slot whose box would touch more than kMaxCells buckets (a vertex carried
+/// far away) is kept in a plain list that every query reads instead, so that memory stays
+/// bounded. The store is not owned: pass the same one to every call.
 class SegmentIndex {
   public:
     explicit SegmentIndex(double cell = 1.0) : cell_(cell) {}
@@ -37,7 +39,11 @@ class SegmentIndex {
     /// Buckets, their slot lists and the hash table's nodes and bucket array, in bytes.
     std::size_t memory_bytes() const;
 
+    /// Buckets a slot may touch before it goes to the plain list.
+    static constexpr double kMaxCells = 4096.0;
+
   private:
+    bool is_large(const Box2& box) const;
     long cell_of(double v) const;
     template <typename F>
     void for_cells(const Box2& box, F&& f) const;
@@ -45,6 +51,7 @@ class SegmentIndex {
 
     double cell_ = 1.0;
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> buckets_;
+    std::vector<std::uint32_t> large_;  // slots too large for the buckets
     // Bounding range of the buckets ever occupied since the last build (not shrunk by erase).
     long imin_ = std::numeric_limits<long>::max(), imax_ = std::numeric_limits<long>::min();
     long jmin_ = std::numeric_limits<long>::max(), jmax_ = std::numeric_limits<long>::min();

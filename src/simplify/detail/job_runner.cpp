@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -185,13 +186,21 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
 
 void JobRunner::execute(Job& job) const {
     SegmentGrid moving(live_.grid().cell());
+    // A result that carries a vertex out of the job's neighbourhood is no local fix: refused
+    // (filing its segments would also touch an unbounded number of grid cells).
+    const Vec2 size = job.footprint.size();
+    const Box2 bound =
+        job.footprint.inflated(2.0 * std::max(std::hypot(size.x, size.y), separations_.max_reach));
     auto is_ok = [&](const Scene& s) {
         const Overlay ov(live_, slots_, job, s, moving);
         moving.clear();
         for (const SegRef& seg : job.moving) {
+            const Vec2 a = ov.pos(seg.layer, seg.start);
+            const Vec2 b = ov.pos(seg.layer, live_.layer(seg.layer).next[seg.start]);
+            if (!bound.contains(a) || !bound.contains(b)) return false;
             Box2 box;
-            box.extend(ov.pos(seg.layer, seg.start));
-            box.extend(ov.pos(seg.layer, live_.layer(seg.layer).next[seg.start]));
+            box.extend(a);
+            box.extend(b);
             moving.insert(seg, box);
         }
         if (!check_.removal_clear(job.l, job.a, job.removed, job.b, ov)) return false;
