@@ -20,13 +20,12 @@ class ExactField final : public LayerField {
                bool indexed)
         : LayerField(layer.name, layer.closed, outside_sign),
           band_(params.band_width),
-          index_(params.bucket_size),
+          index_(params.bucket_size, layer.points.empty() ? Vec2(0.0) : layer.bounds().min),
           indexed_(indexed) {
         check_points(layer.points, layer.closed, "make_field");
-        const Box2 box = layer.bounds();
-        const double reach = std::max(std::abs(box.min.x), std::abs(box.max.x)) +
-                             std::max(std::abs(box.min.y), std::abs(box.max.y));
-        if (indexed_ && reach / params.bucket_size > 1e9)
+        // Buckets count from the layer's corner: only its size matters, not where it lies.
+        const Vec2 size = layer.bounds().size();
+        if (indexed_ && (size.x + size.y) / params.bucket_size > 1e9)
             throw InvalidInput("make_field: layer '" + layer.name +
                                "' is too large for the bucket size");
         store_.build(layer.points, layer.closed, outside_sign);

@@ -549,6 +549,29 @@ TEST_CASE("indexed field: a vertex carried far away keeps memory bounded and ans
     }
 }
 
+TEST_CASE("indexed field: a small layer far from the origin (buckets from its corner)",
+          "[field]") {
+    // Found by fuzz_pipeline: the legs family at scale 1.3e-3 offset by 8.5e5 was refused
+    // ("too large for the bucket size") when buckets were counted from the scene's origin.
+    std::mt19937 rng(8);
+    Layer layer = random_star(rng, 150, true);
+    for (Vec2& p : layer.points) p = 1.3e-3 * p + Vec2(8.5e5, -8.5e5);
+    const Scene scene({layer});
+    const ResolvedFieldParams p = resolve({}, scene);
+    const auto brute = make_field(layer, 1, with_backend(p, FieldBackend::ExactBrute));
+    std::unique_ptr<LayerField> indexed;
+    REQUIRE_NOTHROW(indexed = make_field(layer, 1, with_backend(p, FieldBackend::ExactIndexed)));
+    std::uniform_real_distribution<double> u(-0.01, 0.01);
+    std::size_t differ = 0;
+    for (int q = 0; q < 500; ++q) {
+        const Vec2 x = layer.points[static_cast<std::size_t>(q) % layer.points.size()] +
+                       Vec2(u(rng), u(rng));
+        const FieldSample a = brute->sample(x), b = indexed->sample(x);
+        if (a.value != b.value || a.gradient != b.gradient || a.border != b.border) ++differ;
+    }
+    CHECK(differ == 0);
+}
+
 TEST_CASE("the blocked slot sequence splices like a vector", "[field]") {
     // Enough entries for several blocks; edits that empty blocks, split them and touch the ends.
     detail::SlotSequence seq;

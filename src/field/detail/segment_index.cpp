@@ -15,19 +15,25 @@ std::uint64_t cell_key(long i, long j) {
 }  // namespace
 
 bool SegmentIndex::is_large(const Box2& box) const {
-    const double columns = std::floor(box.max.x / cell_) - std::floor(box.min.x / cell_) + 1.0;
-    const double rows = std::floor(box.max.y / cell_) - std::floor(box.min.y / cell_) + 1.0;
+    const double columns = std::floor((box.max.x - origin_.x) / cell_) -
+                           std::floor((box.min.x - origin_.x) / cell_) + 1.0;
+    const double rows = std::floor((box.max.y - origin_.y) / cell_) -
+                        std::floor((box.min.y - origin_.y) / cell_) + 1.0;
     return !(columns * rows <= kMaxCells);  // NaN too
 }
 
-long SegmentIndex::cell_of(double v) const {
-    return static_cast<long>(std::floor(v / cell_));
+long SegmentIndex::column(double x) const {
+    return static_cast<long>(std::floor((x - origin_.x) / cell_));
+}
+
+long SegmentIndex::row(double y) const {
+    return static_cast<long>(std::floor((y - origin_.y) / cell_));
 }
 
 template <typename F>
 void SegmentIndex::for_cells(const Box2& box, F&& f) const {
-    for (long i = cell_of(box.min.x); i <= cell_of(box.max.x); ++i)
-        for (long j = cell_of(box.min.y); j <= cell_of(box.max.y); ++j) f(i, j);
+    for (long i = column(box.min.x); i <= column(box.max.x); ++i)
+        for (long j = row(box.min.y); j <= row(box.max.y); ++j) f(i, j);
 }
 
 void SegmentIndex::build(const SegmentStore& store) {
@@ -79,7 +85,7 @@ void SegmentIndex::search(const SegmentStore& store, const Vec2& x, Nearest& bes
                           double limit) const {
     for (std::uint32_t s : large_) store.offer(x, s, best);
     if (imin_ > imax_) return;
-    const long ci = cell_of(x.x), cj = cell_of(x.y);
+    const long ci = column(x.x), cj = row(x.y);
     const long start = std::max({imin_ - ci, ci - imax_, jmin_ - cj, cj - jmax_, 0L});
     for (long r = start;; ++r) {
         const long i0 = std::max(ci - r, imin_), i1 = std::min(ci + r, imax_);
@@ -95,10 +101,10 @@ void SegmentIndex::search(const SegmentStore& store, const Vec2& x, Nearest& bes
             for (long j = std::max(j0, cj - r + 1); j <= std::min(j1, cj + r - 1); ++j)
                 visit(store, x, ci + r, j, best);
         if (ci - r <= imin_ && ci + r >= imax_ && cj - r <= jmin_ && cj + r >= jmax_) return;
-        const double lo_x = static_cast<double>(ci - r) * cell_;
-        const double hi_x = static_cast<double>(ci + r + 1) * cell_;
-        const double lo_y = static_cast<double>(cj - r) * cell_;
-        const double hi_y = static_cast<double>(cj + r + 1) * cell_;
+        const double lo_x = origin_.x + static_cast<double>(ci - r) * cell_;
+        const double hi_x = origin_.x + static_cast<double>(ci + r + 1) * cell_;
+        const double lo_y = origin_.y + static_cast<double>(cj - r) * cell_;
+        const double hi_y = origin_.y + static_cast<double>(cj + r + 1) * cell_;
         const double margin = std::min({x.x - lo_x, hi_x - x.x, x.y - lo_y, hi_y - x.y});
         if (best.found() && margin > 0.0 && best.dist2 < margin * margin) return;
         if (margin > limit && !(best.dist2 <= limit * limit)) return;
@@ -109,8 +115,8 @@ void SegmentIndex::candidates(const Box2& box, std::vector<std::uint32_t>& out) 
     out.clear();
     for (std::uint32_t s : large_) out.push_back(s);
     if (imin_ > imax_ && out.empty()) return;
-    const long i0 = std::max(cell_of(box.min.x), imin_), i1 = std::min(cell_of(box.max.x), imax_);
-    const long j0 = std::max(cell_of(box.min.y), jmin_), j1 = std::min(cell_of(box.max.y), jmax_);
+    const long i0 = std::max(column(box.min.x), imin_), i1 = std::min(column(box.max.x), imax_);
+    const long j0 = std::max(row(box.min.y), jmin_), j1 = std::min(row(box.max.y), jmax_);
     for (long i = i0; i <= i1; ++i)
         for (long j = j0; j <= j1; ++j) {
             const auto it = buckets_.find(cell_key(i, j));

@@ -18,7 +18,10 @@ namespace strata::detail {
 /// bounded. The store is not owned: pass the same one to every call.
 class SegmentIndex {
   public:
-    explicit SegmentIndex(double cell = 1.0) : cell_(cell) {}
+    /// Buckets counted from `origin` (e.g. the layer's corner: far from the scene origin,
+    /// bucket numbers stay small).
+    explicit SegmentIndex(double cell = 1.0, const Vec2& origin = Vec2(0.0))
+        : cell_(cell), origin_(origin) {}
 
     /// Indexes every live slot of `store` (replaces the current content).
     void build(const SegmentStore& store);
@@ -44,12 +47,14 @@ class SegmentIndex {
 
   private:
     bool is_large(const Box2& box) const;
-    long cell_of(double v) const;
+    long column(double x) const;
+    long row(double y) const;
     template <typename F>
     void for_cells(const Box2& box, F&& f) const;
     void visit(const SegmentStore& store, const Vec2& x, long i, long j, Nearest& best) const;
 
     double cell_ = 1.0;
+    Vec2 origin_{0.0};
     std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> buckets_;
     std::vector<std::uint32_t> large_;  // slots too large for the buckets
     // Bounding range of the buckets ever occupied since the last build (not shrunk by erase).
