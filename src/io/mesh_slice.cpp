@@ -34,6 +34,7 @@
 #include <mutex>
 #include <numeric>
 #include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -499,7 +500,20 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
     for (std::size_t n = 1; std::getline(in, line); ++n)
         for (auto& t : line_tokens(line.substr(0, line.find('#')), n))
             tokens.push_back(std::move(t));
-    if (tokens.empty() || tokens[0].text != "OFF") return;  // other OFF variants: OpenMesh decides
+    if (tokens.empty()) return;
+    if (tokens[0].text != "OFF") {
+        // A variant (COFF, NOFF, STOFF, 4OFF, nOFF ...): OpenMesh decides. A variant's magic
+        // followed by other characters is refused: OpenMesh read "OFF\b0..." as OFF and
+        // allocated without bound for a face of -3 vertices (found by fuzz_mesh).
+        static const std::regex variant("(ST)?C?N?4?n?OFF");
+        static const std::regex prefixed("(ST)?C?N?4?n?OFF.+");
+        if (std::regex_match(tokens[0].text, prefixed) &&
+            !std::regex_match(tokens[0].text, variant))
+            mesh_text_error(path, tokens[0],
+                            "not an OFF header (got '" + shown_token(tokens[0].text) +
+                                "'; expected OFF, COFF, NOFF, STOFF, 4OFF, nOFF ...)");
+        return;
+    }
     std::size_t next = 1;
     auto take = [&](const char* what) -> const TextToken& {
         if (next >= tokens.size()) {

@@ -336,7 +336,8 @@ TEST_CASE("reading errors name the file", "[mesh_slice]") {
     CHECK(capture.err.str().empty());
 }
 
-TEST_CASE("malformed PLY headers are refused with line and column (fuzz_mesh)", "[mesh_slice]") {
+TEST_CASE("malformed PLY and OFF headers are refused with line and column (fuzz_mesh)",
+          "[mesh_slice]") {
     // OpenMesh 9 looped forever on "format ascii !.0" (fuzz/regressions/mesh).
     const std::string body =
         "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
@@ -363,6 +364,11 @@ TEST_CASE("malformed PLY headers are refused with line and column (fuzz_mesh)", 
                       Contains("end.ply") && Contains("end_header"));
     CHECK_THROWS_WITH(read_slice_mesh(write("magic.ply", "plx\nformat ascii 1.0\n" + body)),
                       Contains("magic.ply:1:1") && Contains("'ply'"));
+    // An OFF magic followed by other characters (OpenMesh took it for OFF and allocated without
+    // bound for a face of -3 vertices; fuzz/regressions/mesh).
+    CHECK_THROWS_WITH(read_slice_mesh(write("magic.off", std::string("OFF\b0\n1 1 0\n0 0 0\n"
+                                                                     "-3 1 2 4\n"))),
+                      Contains("magic.off:1:1") && Contains("not an OFF header"));
     // A valid header still reads (CRLF line ends and comments included).
     const SliceMesh ok = read_slice_mesh(
         write("ok.ply", "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\n" + body));
