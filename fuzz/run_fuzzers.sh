@@ -5,7 +5,8 @@
 # seeds (fuzz/corpus/NAME) and the regressions (fuzz/regressions/NAME), grows a working corpus
 # in BUILD_DIR/fuzz-work/NAME/corpus (the seeds in the repository are not touched), and saves
 # any crashing input there as crash-* / leak-* / timeout-* / oom-*. Exit status: 0 when no
-# fuzzer found anything.
+# fuzzer found anything. FUZZ_KEEP_GOING=1: libFuzzer's fork mode (one worker), which goes on
+# past a crash and saves every one (for long runs).
 set -uo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 build="$(cd "$1" && pwd)"
@@ -28,11 +29,15 @@ for name in "${names[@]}"; do
   # The pipeline's inputs run untanglings: allow each a minute.
   timeout=30
   [ "$name" = pipeline ] && timeout=120
-  "$bin" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2560 -max_len=4096 \
+  keep_going=()
+  [ "${FUZZ_KEEP_GOING:-0}" = 1 ] && keep_going=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
+  "$bin" "${keep_going[@]}" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2560 -max_len=4096 \
     -print_final_stats=1 -artifact_prefix="$work/" "$work/corpus" "${seeds[@]}" \
     >"$work/log.txt" 2>&1
   rc=$?
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$work/log.txt" | grep -o '[0-9]*$' | tail -1)
+  # Fork mode prints no final stats: its last "#N: cov: ..." line counts the executions.
+  [ -n "$execs" ] || execs=$(grep -o '^#[0-9]*: cov' "$work/log.txt" | tail -1 | tr -dc '0-9')
   cov=$(grep -o 'cov: [0-9]*' "$work/log.txt" | tail -1)
   crashes=$(find "$work" -maxdepth 1 -name 'crash-*' -o -maxdepth 1 -name 'leak-*' \
     -o -maxdepth 1 -name 'timeout-*' -o -maxdepth 1 -name 'oom-*' | wc -l)
