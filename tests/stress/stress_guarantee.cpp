@@ -5,13 +5,16 @@
 // no self-crossing, nesting kept, every gap >= (1 - 0.1) x required), and the two thread
 // counts must give the same output, point for point.
 //
-//   stress_guarantee [--scenes N] [--seed S] [--points-max P] [--families F,...] [--verbose]
+//   stress_guarantee [--scenes N] [--seed S] [--points-max P] [--families F,...]
+//                    [--dump FOLDER] [--verbose]
+// --dump writes the input of every failing run to FOLDER/scene<seed>.json (the seed of the run).
 //
 // Prints one summary line of counts; on a violation, one line per failing run with what it
 // takes to reproduce it (family, scale, offset, layers, points, gap, decimator, removal,
 // schedule, threads), and exits 1. Exit 2: bad arguments.
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
+#include "strata/io/json_io.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
 
@@ -25,6 +28,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <new>
 #include <random>
 #include <sstream>
 #include <string>
@@ -39,6 +43,7 @@ struct Options {
     std::uint64_t seed = 1;
     std::size_t points_max = 120;
     bool verbose = false;
+    std::string dump;  // folder: the input of every failing run, as scene JSON
     std::vector<SceneFamily> families = all_scene_families();
 };
 
@@ -101,10 +106,15 @@ bool same_points(const Scene& a, const Scene& b) {
     return true;
 }
 
+void dump_input(const Options& opt, const Scene& input, std::size_t seed) {
+    if (opt.dump.empty()) return;
+    write_scene_json(input, opt.dump + "/scene" + std::to_string(seed) + ".json");
+}
+
 int usage(const char* why) {
     std::fprintf(stderr,
                  "stress_guarantee: %s\nusage: stress_guarantee [--scenes N] [--seed S] "
-                 "[--points-max P >= 21] [--families stack,loops,...] [--verbose]\n",
+                 "[--points-max P >= 21] [--families stack,loops,...] [--dump FOLDER] [--verbose]\n",
                  why);
     return 2;
 }
@@ -126,6 +136,10 @@ int main(int argc, char** argv) {
             if (arg == "--scenes") opt.scenes = n;
             if (arg == "--seed") opt.seed = n;
             if (arg == "--points-max") opt.points_max = n;
+        } else if (arg == "--dump") {
+            const char* v = value();
+            if (!v) return usage("--dump needs a folder");
+            opt.dump = v;
         } else if (arg == "--families") {
             const char* v = value();
             if (!v) return usage("--families needs a list");
@@ -142,6 +156,7 @@ int main(int argc, char** argv) {
     }
     if (opt.points_max < 21) return usage("--points-max must be >= 21");
 
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);  // a killed run still shows how far it came
     const auto start = std::chrono::steady_clock::now();
     std::mt19937_64 rng(opt.seed);
     const char* const decimators[] = {"random", "visvalingam", "max-error"};
@@ -183,8 +198,20 @@ int main(int argc, char** argv) {
                     Scene& out = outputs[threads - 1];
                     SimplifyReport report;
                     ++t.runs;
+                    if (opt.verbose)
+                        std::printf("run %s decimator=%s remove=%g seed=%zu threads=%d\n",
+                                    describe(c).c_str(), decimator, remove, s + 1, threads);
                     try {
                         report = simplify(out, params);
+                    } catch (const std::bad_alloc&) {
+                        ++t.failures;
+                        ++fam[2];
+                        errored = true;
+                        dump_input(opt, input, s + 1);
+                        std::printf("FAIL %s decimator=%s remove=%g seed=%zu threads=%d: out of "
+                                    "memory\n",
+                                    describe(c).c_str(), decimator, remove, s + 1, threads);
+                        break;
                     } catch (const InvalidInput& e) {
                         // Known: the indexed field refuses a small layer far from the origin.
                         ++t.errors;
@@ -210,6 +237,7 @@ int main(int argc, char** argv) {
                         r.is_collision_free() && r.separations_hold() && report.collision_free;
                     ++fam[1];
                     if (!ok) {
+                        dump_input(opt, input, s + 1);
                         ++fam[2];
                         ++t.failures;
                         std::printf(
