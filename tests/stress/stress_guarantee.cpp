@@ -112,10 +112,11 @@ void dump_input(const Options& opt, const Scene& input, std::size_t seed) {
 }
 
 int usage(const char* why) {
-    std::fprintf(stderr,
-                 "stress_guarantee: %s\nusage: stress_guarantee [--scenes N] [--seed S] "
-                 "[--points-max P >= 21] [--families stack,loops,...] [--dump FOLDER] [--verbose]\n",
-                 why);
+    std::fprintf(
+        stderr,
+        "stress_guarantee: %s\nusage: stress_guarantee [--scenes N] [--seed S] "
+        "[--points-max P >= 21] [--families stack,loops,...] [--dump FOLDER] [--verbose]\n",
+        why);
     return 2;
 }
 
@@ -208,9 +209,10 @@ int main(int argc, char** argv) {
                         ++fam[2];
                         errored = true;
                         dump_input(opt, input, s + 1);
-                        std::printf("FAIL %s decimator=%s remove=%g seed=%zu threads=%d: out of "
-                                    "memory\n",
-                                    describe(c).c_str(), decimator, remove, s + 1, threads);
+                        std::printf(
+                            "FAIL %s decimator=%s remove=%g seed=%zu threads=%d: out of "
+                            "memory\n",
+                            describe(c).c_str(), decimator, remove, s + 1, threads);
                         break;
                     } catch (const InvalidInput& e) {
                         // Known: the indexed field refuses a small layer far from the origin.
