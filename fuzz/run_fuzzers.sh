@@ -6,7 +6,8 @@
 # in BUILD_DIR/fuzz-work/NAME/corpus (the seeds in the repository are not touched), and saves
 # any crashing input there as crash-* / leak-* / timeout-* / oom-*. Exit status: 0 when no
 # fuzzer found anything. FUZZ_KEEP_GOING=1: libFuzzer's fork mode (one worker), which goes on
-# past a crash and saves every one (for long runs).
+# past a crash and saves every one (for long runs). FUZZ_SEED=N: libFuzzer's -seed (CI uses a
+# fixed one, so that a short run repeats the same mutations; 0, the default, a random one).
 set -uo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 build="$(cd "$1" && pwd)"
@@ -31,7 +32,7 @@ for name in "${names[@]}"; do
   [ "$name" = pipeline ] && timeout=120
   keep_going=()
   [ "${FUZZ_KEEP_GOING:-0}" = 1 ] && keep_going=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
-  "$bin" "${keep_going[@]}" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2560 -max_len=4096 \
+  "$bin" "${keep_going[@]}" -seed="${FUZZ_SEED:-0}" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2560 -max_len=4096 \
     -print_final_stats=1 -artifact_prefix="$work/" "$work/corpus" "${seeds[@]}" \
     >"$work/log.txt" 2>&1
   rc=$?
