@@ -260,7 +260,12 @@ int main(int argc, char** argv) {
                 }
             }
         }
-        if (opt.verbose) std::printf("scene %zu: %s done\n", s, describe(c).c_str());
+        if ((s + 1) % 100 == 0)
+            std::printf(
+                "progress: %zu scenes generated, %zu runs, %zu failing, %zu thread "
+                "mismatches, %zu errors, %.0f s\n",
+                s + 1, t.runs, t.failures, t.thread_mismatches, t.errors,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
