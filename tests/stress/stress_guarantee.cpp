@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <new>
@@ -108,6 +109,7 @@ bool same_points(const Scene& a, const Scene& b) {
 
 void dump_input(const Options& opt, const Scene& input, std::size_t seed) {
     if (opt.dump.empty()) return;
+    std::filesystem::create_directories(opt.dump);
     write_scene_json(input, opt.dump + "/scene" + std::to_string(seed) + ".json");
 }
 
