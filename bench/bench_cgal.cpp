@@ -1,11 +1,13 @@
 // strata against CGAL's Polyline_simplification_2, the peer a user would pick instead, on the
 // same scenes and the same vertex budget, both outputs scored by strata's exact checks.
 //
-//   strata_bench_cgal [--max POINTS] [--slices DIR]
+//   strata_bench_cgal [--max POINTS] [--layers L,...] [--points N,...] [--remove R,...]
+//                     [--slices DIR]
 //
-// Scenes: folded_stack() with 5 and 8 layers and 2000 and 10000 points per layer (up to
-// --max, default 10000), then every *.json slice in --slices (default ../shared/data/slices,
-// from the project root; skipped when the folder does not exist). Removal 0.90, 0.95, 0.98.
+// Scenes: folded_stack() with --layers (5, 8) layers and --points (2000, 10000) points per
+// layer (up to --max, default 10000, unless --points is given), then every *.json slice in
+// --slices (default ../shared/data/slices, from the project root; skipped when the folder
+// does not exist, e.g. "none"). Removal --remove (0.90, 0.95, 0.98).
 //
 // strata: simplify(scene, params) with params.remove = rm, other parameters at their defaults;
 // its time includes its own final check (the "chk s" column).
@@ -180,6 +182,8 @@ void print_row(const std::string& name, const Scene& input, std::size_t points, 
                 verts.c_str(), target.c_str(), total.c_str(), max_h, collapsed);
 }
 
+std::vector<double> removals{0.90, 0.95, 0.98};  // --remove
+
 void compare(const std::string& name, const Scene& input, std::size_t points) {
     // The input's own score first: a flaw already there is not the tools' doing.
     RunResult original;
@@ -187,7 +191,7 @@ void compare(const std::string& name, const Scene& input, std::size_t points) {
     const Score input_score = score(input, input);
     print_row(name, input, points, 0.0, "input", original, &input_score, input_score.min_verts,
               input_score.max_verts, input_score.total_verts, "-");
-    for (const double remove : {0.90, 0.95, 0.98}) {
+    for (const double remove : removals) {
         std::size_t target_min = std::numeric_limits<std::size_t>::max(), target_max = 0,
                     budget = 0;
         std::vector<std::size_t> targets;
@@ -226,29 +230,65 @@ void compare(const std::string& name, const Scene& input, std::size_t points) {
 
 }  // namespace
 
+// "a,b,c" as numbers; empty on a bad item.
+std::vector<double> number_list(const std::string& text) {
+    std::vector<double> out;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = text.find(',', start);
+        const std::string item = text.substr(start, comma - start);
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !(v > 0.0)) return {};
+        out.push_back(v);
+        if (comma == std::string::npos) return out;
+        start = comma + 1;
+    }
+}
+
 int main(int argc, char** argv) {
     std::size_t max_points = 10000;
+    std::vector<double> layer_counts{5, 8}, point_counts{2000, 10000};
     std::filesystem::path slices = "../shared/data/slices";
     for (int i = 1; i < argc; i += 2) {
         const std::string key = argv[i];
-        if (i + 1 < argc && key == "--max") {
+        const std::string value = i + 1 < argc ? argv[i + 1] : "";
+        bool ok = i + 1 < argc;
+        if (ok && key == "--max") {
             max_points = std::strtoul(argv[i + 1], nullptr, 10);
-        } else if (i + 1 < argc && key == "--slices") {
-            slices = argv[i + 1];
+        } else if (ok && key == "--slices") {
+            slices = value;
+        } else if (ok && key == "--layers") {
+            layer_counts = number_list(value);
+            ok = !layer_counts.empty();
+        } else if (ok && key == "--points") {
+            point_counts = number_list(value);
+            ok = !point_counts.empty();
+            max_points = std::numeric_limits<std::size_t>::max();
+        } else if (ok && key == "--remove") {
+            removals = number_list(value);
+            ok = !removals.empty();
+            for (double r : removals) ok = ok && r < 1.0;
         } else {
-            std::fprintf(stderr,
-                         "usage: strata_bench_cgal [--max POINTS (10000)] [--slices DIR "
-                         "(../shared/data/slices)]\n");
+            ok = false;
+        }
+        if (!ok) {
+            std::fprintf(
+                stderr,
+                "usage: strata_bench_cgal [--max POINTS (10000)] [--layers L[,L...] (5,8)] "
+                "[--points N[,N...] (2000,10000; no --max cap)] [--remove R[,R...] "
+                "(0.9,0.95,0.98)] [--slices DIR|none (../shared/data/slices)]\n");
             return 2;
         }
     }
     print_header();
-    for (const std::size_t layers : {std::size_t(5), std::size_t(8)})
-        for (const std::size_t points : {std::size_t(2000), std::size_t(10000)}) {
-            if (points > max_points) continue;
+    for (const double layers : layer_counts)
+        for (const double points : point_counts) {
+            if (points > static_cast<double>(max_points)) continue;
             const Scene input =
-                folded_stack(layers, points, 10.0 * static_cast<double>(points) / 600.0);
-            compare("folded_stack", input, points);
+                folded_stack(static_cast<std::size_t>(layers), static_cast<std::size_t>(points),
+                             10.0 * points / 600.0);
+            compare("folded_stack", input, static_cast<std::size_t>(points));
         }
     std::error_code error;
     if (!std::filesystem::is_directory(slices, error)) return 0;

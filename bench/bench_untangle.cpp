@@ -15,6 +15,10 @@
 // --write DIR: every case's tangled input (NAME.tangled.json) and result (NAME.json, and
 // NAME.svg with the tangled input drawn faintly under it), DIR existing.
 // --timing: the two timing cases instead (12 loops x 150 and 6 x 300 stack, naive 90%).
+// --slices DIR (default tests/data/crossing_slices, when run from the repository's root): the
+// scenes of DIR (.json, .svg) whose input already crosses, untangled as they are (tangle
+// "real"): slices of real garments (../shared/data/garments, bench/garments.sh) where the
+// meshes interpenetrate. "--slices none" leaves them out.
 
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
@@ -33,6 +37,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -139,7 +144,7 @@ std::string write_dir;  // --write
 Row run(const std::string& name, const std::string& how, const Scene& input,
         const UntangleParams& params, double cap_seconds) {
     const CheckReport original = check_scene(input);
-    const Scene tangled = tangle(input, how);
+    const Scene tangled = how == "real" ? input : tangle(input, how);
     const CheckReport before = check_scene(tangled);
     Scene scene = tangled;
     const double start = now();
@@ -199,7 +204,7 @@ void timing(const UntangleParams& params) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string family, how, backend = "indexed";
+    std::string family, how, backend = "indexed", slices = "tests/data/crossing_slices";
     std::size_t points = 300;
     bool timed = false;
     for (int i = 1; i < argc; ++i) {
@@ -223,11 +228,13 @@ int main(int argc, char** argv) {
             timed = true;
         else if (key == "--write")
             write_dir = value();
+        else if (key == "--slices")
+            slices = value();
         else {
             std::fprintf(stderr,
                          "usage: strata_bench_untangle [--family NAME] [--tangle "
-                         "naive90|naive95|dp] [--backend indexed|grid] [--points N] [--timing] "
-                         "[--write DIR]\n");
+                         "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
+                         "[--timing] [--write DIR] [--slices DIR|none]\n");
             return 2;
         }
     }
@@ -236,6 +243,7 @@ int main(int argc, char** argv) {
                      backend.c_str());
         return 2;
     }
+    if (!write_dir.empty()) std::filesystem::create_directories(write_dir);
     UntangleParams params;
     params.field.backend = backend == "grid" ? FieldBackend::Grid : FieldBackend::ExactIndexed;
     std::printf("%-22s %-8s %11s %11s %11s %7s %6s %8s %8s %10s %5s\n", "scene", "tangle",
@@ -254,6 +262,24 @@ int main(int argc, char** argv) {
             ++total;
             clean += run(c.name, t, c.input, params, 60.0).clean;
         }
+    if (slices != "none" && family.empty() && (how.empty() || how == "real")) {
+        if (!std::filesystem::is_directory(slices)) {
+            std::fprintf(stderr, "strata_bench_untangle: no folder '%s' (--slices): skipped\n",
+                         slices.c_str());
+        } else {
+            std::vector<std::filesystem::path> files;
+            for (const auto& entry : std::filesystem::directory_iterator(slices))
+                if (entry.path().extension() == ".json" || entry.path().extension() == ".svg")
+                    files.push_back(entry.path());
+            std::sort(files.begin(), files.end());
+            for (const std::filesystem::path& file : files) {
+                const Scene input = read_scene(file);
+                if (check_scene(input).is_collision_free()) continue;  // nothing to untangle
+                ++total;
+                clean += run(file.stem().string(), "real", input, params, 60.0).clean;
+            }
+        }
+    }
     seconds = now() - start;
     std::printf("%d of %d clean (%.1f s in all)\n", clean, total, seconds);
     return 0;

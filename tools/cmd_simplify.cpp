@@ -1,6 +1,7 @@
 // strata simplify: collision-free simplification of one scene, a demo, or a batch of slices.
 #include "cli_util.h"
 #include "commands.h"
+#include "simplify_batch.h"
 
 #include "strata/core/error.h"
 #include "strata/core/format.h"
@@ -30,81 +31,6 @@ namespace strata::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-// What to do with an input that already crosses (or breaks its nesting).
-enum class InputCrossings { Untangle, Skip, Fail };
-
-struct SimplifyOptions {
-    std::vector<std::string> inputs;
-    std::string output, svg, report;
-    double thickness = 0.0;
-    int threads = 0;
-    bool no_shape_matching = false;
-    bool no_finish = false;
-    bool naive = false;
-    bool compare_naive = false;  // also run the naive decimation, for the numbers
-    InputCrossings input_crossings = InputCrossings::Untangle;
-    SimplifyParams params;
-};
-
-nlohmann::json finite_or_null(double v) {
-    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
-nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive) {
-    nlohmann::json layers = nlohmann::json::array();
-    for (const LayerSimplifyReport& l : r.layers)
-        layers.push_back({{"name", l.name},
-                          {"before", l.before},
-                          {"after", l.after},
-                          {"target", l.target},
-                          {"refused", l.refused},
-                          {"untangled", l.untangled},
-                          {"hausdorff", l.hausdorff},
-                          {"max_displacement", l.max_displacement}});
-    nlohmann::json j = {{"layers", layers},
-                        {"removed", r.removed},
-                        {"untangle_calls", r.untangle_calls},
-                        {"refused", r.refused},
-                        {"gave_up", r.gave_up},
-                        {"deferred", r.deferred},
-                        {"rounds", r.rounds},
-                        {"batches", r.batches},
-                        {"batch_reruns", r.batch_reruns},
-                        {"targets_met", r.targets_met},
-                        {"raised_separations", r.raised_separations},
-                        {"crossings", r.crossings},
-                        {"self_crossings", r.self_crossings},
-                        {"nesting_violations", r.nesting_violations},
-                        {"min_separation_ratio", finite_or_null(r.min_separation_ratio)},
-                        {"collision_free", r.collision_free},
-                        {"seconds",
-                         {{"decimate", r.seconds_decimate},
-                          {"fields", r.seconds_fields},
-                          {"untangle", r.seconds_untangle},
-                          {"finish", r.seconds_finish},
-                          {"check", r.seconds_check},
-                          {"total", r.seconds_total}}}};
-    if (naive)
-        j["naive"] = {{"crossings", naive->crossings},
-                      {"self_crossings", naive->self_crossings},
-                      {"nesting_violations", naive->nesting_violations},
-                      {"min_separation_ratio", finite_or_null(naive->min_separation_ratio)}};
-    return j;
-}
-
-// Peak resident memory of this process so far, MiB (getrusage).
-double peak_memory_mib() {
-    rusage usage{};
-    if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
-    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux: KiB
-}
-
-double max_hausdorff(const SimplifyReport& r) {
-    double h = 0.0;
-    for (const LayerSimplifyReport& l : r.layers) h = std::max(h, l.hausdorff);
-    return h;
-}
 
 void print_summary(const std::string& name, const SimplifyReport& r, const SimplifyReport* naive) {
     std::printf("%-22s %8s %8s %8s %8s %9s %12s\n", "layer", "before", "after", "target", "refused",
@@ -149,120 +75,6 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             name.c_str(), r.refused);
 }
 
-// What was done to an input that already crossed before it was simplified.
-struct InputUntangling {
-    std::size_t crossings = 0, nesting_violations = 0;  // of the input
-    UntangleReport report;
-};
-
-// One line on what is wrong with `check` (an input's), naming the first culprit.
-std::string tangle_summary(const Scene& scene, const CheckReport& check) {
-    std::string text = std::to_string(check.crossing_count) + " crossings between layers, " +
-                       std::to_string(check.total_self_crossings()) + " self-crossings, " +
-                       std::to_string(check.nesting_violation_count) + " nesting violations";
-    if (!check.crossings.empty()) {
-        const Crossing& c = check.crossings.front();
-        text += "; first: layer '" + scene.layer(c.layer_a).name + "' segment " +
-                std::to_string(c.segment_a) + " x layer '" + scene.layer(c.layer_b).name +
-                "' segment " + std::to_string(c.segment_b) + " at (" + format_number(c.point.x) +
-                ", " + format_number(c.point.y) + ")";
-    } else if (!check.self_crossings.empty()) {
-        const Crossing& c = check.self_crossings.front();
-        const Layer& layer = scene.layer(c.layer_a);
-        if (layer.closed && is_flat(layer.points)) {
-            text += "; first: layer '" + layer.name +
-                    "' is flat: all its points are collinear (a closed layer needs an area)";
-            return text;
-        }
-        text += "; first: layer '" + scene.layer(c.layer_a).name + "' crosses itself (segments " +
-                std::to_string(c.segment_a) + " and " + std::to_string(c.segment_b) + " at (" +
-                format_number(c.point.x) + ", " + format_number(c.point.y) + "))";
-    } else if (!check.nesting_violations.empty()) {
-        const NestingViolation& v = check.nesting_violations.front();
-        text += "; first: layer '" + scene.layer(v.layer).name + "' point " +
-                std::to_string(v.vertex) + " on the wrong side of layer '" +
-                scene.layer(v.other).name + "'";
-    }
-    return text;
-}
-
-// Simplification keeps a collision-free scene so. An input that already crosses is untangled
-// first (InputCrossings::Untangle: the global untangling, which cannot mend a layer that
-// crosses itself), or refused (Fail: InvalidInput; Skip: std::nullopt).
-std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
-                                   const SimplifyParams& params,
-                                   std::optional<InputUntangling>& untangled) {
-    const CheckReport before = check_scene(input);
-    if (before.is_collision_free()) return input;
-    const std::string what = tangle_summary(input, before);
-    if (mode == InputCrossings::Skip) return std::nullopt;
-    if (mode == InputCrossings::Fail || before.total_self_crossings() > 0)
-        throw InvalidInput(name + ": the input is not collision-free (" + what + ")" +
-                           (mode == InputCrossings::Fail
-                                ? "; not simplified (--input-crossings untangle mends it first)"
-                                : "; a layer that crosses itself cannot be untangled"));
-    Scene scene = input;
-    UntangleParams u = params.untangling;
-    // The global untangling's own pass structure (untangle()'s defaults), the driver's field
-    // and shape settings.
-    const UntangleParams defaults;
-    u.gradient_steps = defaults.gradient_steps;
-    u.max_rounds = defaults.max_rounds;
-    u.max_passes = defaults.max_passes;
-    u.give_up_when_stalled = false;
-    InputUntangling info;
-    info.crossings = before.crossing_count;
-    info.nesting_violations = before.nesting_violation_count;
-    info.report = untangle(scene, u);
-    const CheckReport after = check_scene(scene);
-    if (!after.is_collision_free())
-        throw InvalidInput(name + ": the input is not collision-free (" + what +
-                           ") and untangling it left " + tangle_summary(scene, after) +
-                           "; not simplified");
-    untangled = info;
-    return scene;
-}
-
-nlohmann::json untangling_json(const InputUntangling& u) {
-    return {{"crossings", u.crossings},
-            {"nesting_violations", u.nesting_violations},
-            {"moved_vertices", u.report.moved_vertices},
-            {"max_displacement", u.report.max_displacement},
-            {"min_separation_ratio_after", finite_or_null(u.report.min_separation_ratio_after)},
-            {"passes", u.report.passes},
-            {"seconds", u.report.seconds_fields + u.report.seconds_untangle +
-                            u.report.seconds_finish + u.report.seconds_check}};
-}
-
-struct Outcome {
-    std::string input, output;
-    std::optional<SimplifyReport> report, naive;
-    std::optional<InputUntangling> untangled;  // the input crossed and was untangled first
-    bool skipped = false;                      // the input crossed (--input-crossings skip)
-    std::string error;
-};
-
-// Simplifies one scene; the naive run (no untangling) is made beside it when asked for.
-Outcome run_one(const Scene& input, const SimplifyOptions& opt, const ProgressFn& progress,
-                Scene& result, Scene* naive_result) {
-    Outcome out;
-    if (opt.compare_naive || opt.naive) {
-        SimplifyParams naive_params = opt.params;
-        naive_params.untangle = false;
-        Scene naive = input;
-        out.naive = simplify(naive, naive_params);
-        if (naive_result) *naive_result = naive;
-        if (opt.naive) {
-            result = naive;
-            out.report = out.naive;
-            return out;
-        }
-    }
-    result = input;
-    out.report = simplify(result, opt.params, progress);
-    return out;
-}
-
 int run_demo(const SimplifyOptions& opt) {
     const fs::path dir = opt.output.empty() ? fs::path("strata-demo") : fs::path(opt.output);
     fs::create_directories(dir);
@@ -294,93 +106,24 @@ int run_demo(const SimplifyOptions& opt) {
     return o.report->collision_free ? 0 : 1;
 }
 
-std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
-    std::vector<std::string> files;
-    for (const std::string& in : inputs) {
-        if (fs::is_directory(in)) {
-            std::vector<std::string> found;
-            for (const auto& entry : fs::directory_iterator(in))
-                if (entry.is_regular_file() &&
-                    (entry.path().extension() == ".json" || entry.path().extension() == ".svg"))
-                    found.push_back(entry.path().string());
-            std::sort(found.begin(), found.end());
-            files.insert(files.end(), found.begin(), found.end());
-        } else {
-            files.push_back(in);
-        }
-    }
-    return files;
-}
-
 int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files) {
     if (opt.output.empty()) throw InvalidInput("simplify: several inputs need -o FOLDER");
     if (!fs::is_directory(opt.output)) fs::create_directories(opt.output);
     std::vector<Outcome> outcomes(files.size());
     tbb::parallel_for(std::size_t(0), files.size(), [&](std::size_t i) {
-        Outcome& o = outcomes[i];
-        o.input = files[i];
-        o.output = (fs::path(opt.output) / (fs::path(files[i]).stem().string() + ".json")).string();
-        try {
-            ensure_not_an_input(o.output, {fs::path(files[i])});
-            const Scene read = with_default_thickness(read_scene(files[i]), opt.thickness);
-            const std::optional<Scene> input =
-                prepare_input(read, files[i], opt.input_crossings, opt.params, o.untangled);
-            if (!input) {
-                o.skipped = true;
-                return;
-            }
-            Scene result;
-            Outcome r = run_one(*input, opt, {}, result, nullptr);
-            write_scene(result, o.output);
-            o.report = std::move(r.report);
-            o.naive = std::move(r.naive);
-        } catch (const std::exception& e) {
-            o.error = e.what();
-        }
+        outcomes[i] = simplify_slice(files[i], batch_output(opt.output, files[i]), opt);
     });
-    std::printf("%-40s %8s %8s %7s %7s %7s %8s %9s %8s\n", "slice", "before", "after", "input-x",
-                "naive-x", "strata-x", "refused", "hausdorff", "time-s");
-    std::size_t failed = 0, tangled = 0, skipped = 0, untangled = 0;
+    std::fputs(batch_header().c_str(), stdout);
+    BatchTotals totals;
     nlohmann::json all = nlohmann::json::array();
     for (const Outcome& o : outcomes) {
-        const std::string name = fs::path(o.input).filename().string();
-        if (!o.error.empty()) {
-            ++failed;
-            std::printf("%-40s FAILED: %s\n", name.c_str(), o.error.c_str());
-            all.push_back({{"input", o.input}, {"error", o.error}});
-            continue;
-        }
-        if (o.skipped) {
-            ++skipped;
-            std::printf("%-40s skipped: the input crosses (--input-crossings skip)\n",
-                        name.c_str());
-            all.push_back({{"input", o.input}, {"skipped", true}});
-            continue;
-        }
-        if (o.untangled) ++untangled;
-        std::size_t before = 0, after = 0;
-        for (const LayerSimplifyReport& l : o.report->layers) {
-            before += l.before;
-            after += l.after;
-        }
-        if (!o.report->collision_free) ++tangled;
-        std::printf("%-40s %8zu %8zu %7s %7s %7zu %8zu %9.3g %8.3f\n", name.c_str(), before, after,
-                    o.untangled ? std::to_string(o.untangled->crossings).c_str() : "0",
-                    o.naive ? std::to_string(o.naive->crossings).c_str() : "-", o.report->crossings,
-                    o.report->refused, max_hausdorff(*o.report), o.report->seconds_total);
-        nlohmann::json j = report_json(*o.report, o.naive ? &*o.naive : nullptr);
-        j["input"] = o.input;
-        j["output"] = o.output;
-        if (o.untangled) j["input_untangled"] = untangling_json(*o.untangled);
-        all.push_back(j);
+        totals.add(o);
+        std::fputs(batch_row(o).c_str(), stdout);
+        all.push_back(batch_entry(o));
     }
-    std::printf(
-        "%zu slices: %zu simplified (%zu of them untangled first), %zu skipped, %zu failed "
-        "(nothing written for them), %zu not collision-free; peak memory %.0f MiB\n",
-        outcomes.size(), outcomes.size() - failed - skipped, untangled, skipped, failed, tangled,
-        peak_memory_mib());
+    std::fputs(batch_footer(totals, peak_memory_mib()).c_str(), stdout);
     if (!opt.report.empty()) write_file_atomic(opt.report, all.dump(2) + "\n");
-    return failed == 0 && tangled == 0 && skipped == 0 ? 0 : 1;
+    return totals.exit_code();
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #ifndef BOOST_ALLOW_DEPRECATED_HEADERS
 #define BOOST_ALLOW_DEPRECATED_HEADERS
 #endif
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <boost/geometry/geometries/box.hpp>
 #include <boost/geometry/geometries/point.hpp>
 #include <boost/geometry/index/rtree.hpp>
@@ -213,11 +215,11 @@ double automatic_near(const Scene& scene) {
     return std::max(0.05 * std::hypot(size.x, size.y), 2.0 * max_required);
 }
 
-// Side of `v` with respect to the open or closed layer of `index`, at its closest point:
-// +1 right of the direction of travel, -1 left, 0 when not decided (farther than `near`, on
-// the layer, or closest to an end point of an open layer).
-int side_at(const SegmentIndex& index, const Vec2& v, double near) {
-    const Nearest n = nearest_on(index, v, near);
+// Side of `v` with respect to the open or closed layer of `index`, given `n`, its closest
+// point there within `near` (not found when farther): +1 right of the direction of travel, -1
+// left, 0 when not decided (farther than `near`, on the layer, or closest to an end point of
+// an open layer).
+int side_of(const SegmentIndex& index, const Vec2& v, const Nearest& n) {
     if (!n.found() || n.distance == 0.0) return 0;
     const std::size_t s = n.segment;
     const Vec2 a = index.start(s), b = index.end(s);
@@ -243,6 +245,11 @@ int side_at(const SegmentIndex& index, const Vec2& v, double near) {
     if (turn > 0) return (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
     if (turn < 0) return (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
     return o1 != 0 ? -o1 : -o2;
+}
+
+// side_of() at the closest point within `near`.
+int side_at(const SegmentIndex& index, const Vec2& v, double near) {
+    return side_of(index, v, nearest_on(index, v, near));
 }
 
 int closed_outside(const Layer& layer) {
@@ -374,6 +381,7 @@ class Checker {
 
     CheckReport run() {
         find_contacts();
+        find_outside_sides();
         find_separations();
         find_nesting_violations();
         return std::move(report_);
@@ -469,50 +477,88 @@ class Checker {
             report_.self_crossings.push_back(to_crossing(c));
     }
 
+    // One near pair's separation scan (find_separations()).
+    struct PairScan {
+        std::size_t i = 0, j = 0;
+        double required = 0.0;
+        bool listed = false;  // a near pair: goes into the report
+        PairSeparation pair;
+        std::vector<SeparationViolation> violations;
+    };
+
+    // Pairs are scanned in parallel (TBB; one thread under a max_allowed_parallelism of 1),
+    // then reported in (i, j) order: the report does not depend on the threads.
     void find_separations() {
         const double near = report_.near_distance;
-        const double tolerance = params_.separation_tolerance;
+        std::vector<PairScan> scans;
         for (std::size_t i = 0; i < n_; ++i)
             for (std::size_t j = i + 1; j < n_; ++j) {
                 const double required = scene_.required_separation(i, j);
-                const double threshold = required * (1.0 - tolerance);
-                const double cutoff = std::max(near, threshold);
+                const double cutoff =
+                    std::max(near, required * (1.0 - params_.separation_tolerance));
                 if (!bounds_[i].inflated(cutoff).overlaps(bounds_[j])) continue;
-                const bool met = met_[i * n_ + j] != 0;
-                if (met && threshold <= 0.0) {
-                    add_pair(i, j, 0.0, required, met_point_[i * n_ + j], met_point_[i * n_ + j]);
-                    continue;
-                }
-                PairSeparation pair;
-                pair.gap = met ? 0.0 : kInf;
-                pair.at_a = pair.at_b = met_point_[i * n_ + j];
-                std::vector<SeparationViolation> violations;
-                auto scan = [&](std::size_t from, std::size_t to, bool from_is_a) {
-                    const std::vector<Vec2>& points = scene_.layer(from).points;
-                    for (std::size_t k = 0; k < points.size(); ++k) {
-                        // Only a vertex closer than the pair's gap so far, or than required,
-                        // changes anything: the search stops there.
-                        const double bound = std::max(threshold, std::min(cutoff, pair.gap));
-                        const Nearest nr = nearest_on(indices_[to], points[k], bound);
-                        if (!nr.found()) continue;
-                        if (nr.distance < pair.gap) {
-                            pair.gap = nr.distance;
-                            pair.at_a = from_is_a ? points[k] : nr.point;
-                            pair.at_b = from_is_a ? nr.point : points[k];
-                        }
-                        if (nr.distance < threshold)
-                            violations.push_back({from, k, to, nr.distance, required});
-                    }
-                };
-                scan(i, j, true);
-                scan(j, i, false);
-                if (!(pair.gap < near)) continue;
-                add_pair(i, j, pair.gap, required, pair.at_a, pair.at_b);
-                report_.separation_violation_count += violations.size();
-                for (const SeparationViolation& v : violations)
-                    if (report_.separation_violations.size() < params_.max_listed)
-                        report_.separation_violations.push_back(v);
+                PairScan scan;
+                scan.i = i;
+                scan.j = j;
+                scan.required = required;
+                scans.push_back(std::move(scan));
             }
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scans.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t k = range.begin(); k != range.end(); ++k)
+                                  scan_pair(scans[k]);
+                          });
+        for (const PairScan& scan : scans) {
+            if (!scan.listed) continue;
+            add_pair(scan.i, scan.j, scan.pair.gap, scan.required, scan.pair.at_a, scan.pair.at_b);
+            report_.separation_violation_count += scan.violations.size();
+            for (const SeparationViolation& v : scan.violations)
+                if (report_.separation_violations.size() < params_.max_listed)
+                    report_.separation_violations.push_back(v);
+        }
+    }
+
+    void scan_pair(PairScan& scan) const {
+        const std::size_t i = scan.i, j = scan.j;
+        const double near = report_.near_distance;
+        const double threshold = scan.required * (1.0 - params_.separation_tolerance);
+        const double cutoff = std::max(near, threshold);
+        PairSeparation& pair = scan.pair;
+        const bool met = met_[i * n_ + j] != 0;
+        pair.gap = met ? 0.0 : kInf;
+        pair.at_a = pair.at_b = met_point_[i * n_ + j];
+        if (met && threshold <= 0.0) {
+            scan.listed = true;
+            return;
+        }
+        auto one_way = [&](std::size_t from, std::size_t to, bool from_is_a) {
+            // Where nesting is decided by the side at the closest point, the same queries
+            // (then with the whole cutoff >= near) decide it too.
+            const bool sides = sides_by_nearest(from, to);
+            if (sides) sides_scanned_[from * n_ + to] = 1;
+            const std::vector<Vec2>& points = scene_.layer(from).points;
+            for (std::size_t k = 0; k < points.size(); ++k) {
+                // Only a vertex closer than the pair's gap so far, or than required, changes
+                // the separation: the search stops there.
+                const double bound =
+                    sides ? cutoff : std::max(threshold, std::min(cutoff, pair.gap));
+                const Nearest nr = nearest_on(indices_[to], points[k], bound);
+                if (!nr.found()) continue;
+                if (sides && nr.distance < near &&
+                    breaks_nesting(from, to, side_of(indices_[to], points[k], nr)))
+                    wrong_side_[from * n_ + to].push_back(k);
+                if (nr.distance < pair.gap) {
+                    pair.gap = nr.distance;
+                    pair.at_a = from_is_a ? points[k] : nr.point;
+                    pair.at_b = from_is_a ? nr.point : points[k];
+                }
+                if (nr.distance < threshold)
+                    scan.violations.push_back({from, k, to, nr.distance, scan.required});
+            }
+        };
+        one_way(i, j, true);
+        one_way(j, i, false);
+        scan.listed = pair.gap < near;
     }
 
     void add_pair(std::size_t i, std::size_t j, double gap, double required, const Vec2& at_a,
@@ -530,39 +576,74 @@ class Checker {
         report_.pairs.push_back(pair);
     }
 
-    void find_nesting_violations() {
-        const double near = report_.near_distance;
-        std::vector<int> outside(n_, 0);
-        for (std::size_t b = 0; b < n_; ++b)
+    // Outside sides of the open layers (see outside_side()).
+    void find_outside_sides() {
+        outside_.assign(n_, 0);
+        tbb::parallel_for(std::size_t{0}, n_, [&](std::size_t b) {
             if (!scene_.layer(b).closed)
-                outside[b] = params_.outside_sides.empty()
-                                 ? open_outside(scene_, b, indices_[b], near)
-                                 : params_.outside_sides[b];
+                outside_[b] = params_.outside_sides.empty()
+                                  ? open_outside(scene_, b, indices_[b], report_.near_distance)
+                                  : params_.outside_sides[b];
+        });
+        sides_scanned_.assign(n_ * n_, 0);
+        wrong_side_.assign(n_ * n_, {});
+    }
+
+    // Nesting of layer a against open layer b is decided by the side of b at each vertex's
+    // closest point (within near); false where it is decided otherwise or not at all.
+    bool sides_by_nearest(std::size_t a, std::size_t b) const {
+        return !scene_.layer(b).closed && scene_.relation(a, b) != Relation::SideBySide &&
+               bounds_[a].overlaps(bounds_[b].inflated(report_.near_distance));
+    }
+
+    // A vertex of layer a on `side` (side_of()) of open layer b breaks their nesting.
+    bool breaks_nesting(std::size_t a, std::size_t b, int side) const {
+        const Relation rel = scene_.relation(a, b);
+        return side != 0 && (rel == Relation::Under ? side == outside_[b] : side == -outside_[b]);
+    }
+
+    // Ordered pairs in parallel, reported in (a, b) order.
+    void find_nesting_violations() {
+        std::vector<std::pair<std::size_t, std::size_t>> tasks;
+        for (std::size_t a = 0; a < n_; ++a)
+            for (std::size_t b = 0; b < n_; ++b)
+                if (a != b && !sides_scanned_[a * n_ + b] &&
+                    (scene_.layer(b).closed || sides_by_nearest(a, b)))
+                    tasks.emplace_back(a, b);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t k = range.begin(); k != range.end(); ++k)
+                                  find_wrong_side(tasks[k].first, tasks[k].second);
+                          });
         for (std::size_t a = 0; a < n_; ++a)
             for (std::size_t b = 0; b < n_; ++b) {
                 if (a == b) continue;
-                const Relation rel = scene_.relation(a, b);
-                const Layer& other = scene_.layer(b);
-                if (!other.closed && rel == Relation::SideBySide) continue;
-                if (!other.closed && !bounds_[a].overlaps(bounds_[b].inflated(near))) continue;
-                const std::vector<Vec2>& points = scene_.layer(a).points;
-                for (std::size_t k = 0; k < points.size(); ++k) {
-                    bool broken = false;
-                    if (other.closed) {
-                        const Placement where = placement(indices_[b], bounds_[b], points[k]);
-                        broken = rel == Relation::Under ? where == Placement::Outside
-                                                        : where == Placement::Inside;
-                    } else {
-                        const int side = side_at(indices_[b], points[k], near);
-                        broken = side != 0 && (rel == Relation::Under ? side == outside[b]
-                                                                      : side == -outside[b]);
-                    }
-                    if (!broken) continue;
+                for (std::size_t k : wrong_side_[a * n_ + b]) {
                     ++report_.nesting_violation_count;
                     if (report_.nesting_violations.size() < params_.max_listed)
-                        report_.nesting_violations.push_back({a, k, b, rel});
+                        report_.nesting_violations.push_back({a, k, b, scene_.relation(a, b)});
                 }
             }
+    }
+
+    // The vertices of layer a on the wrong side of layer b, into wrong_side_[a * n + b].
+    void find_wrong_side(std::size_t a, std::size_t b) const {
+        const Relation rel = scene_.relation(a, b);
+        const Layer& other = scene_.layer(b);
+        const std::vector<Vec2>& points = scene_.layer(a).points;
+        std::vector<std::size_t>& out = wrong_side_[a * n_ + b];
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            bool broken = false;
+            if (other.closed) {
+                const Placement where = placement(indices_[b], bounds_[b], points[k]);
+                broken = rel == Relation::Under ? where == Placement::Outside
+                                                : where == Placement::Inside;
+            } else {
+                broken =
+                    breaks_nesting(a, b, side_at(indices_[b], points[k], report_.near_distance));
+            }
+            if (broken) out.push_back(k);
+        }
     }
 
     const Scene& scene_;
@@ -572,6 +653,12 @@ class Checker {
     std::vector<Box2> bounds_;
     std::vector<char> met_;  // met_[a * n + b], a < b: the layers cross or touch
     std::vector<Vec2> met_point_;
+    std::vector<int> outside_;  // per open layer: outside_side()
+    // sides_scanned_[a * n + b]: find_separations() decided the nesting of a against b, and
+    // wrong_side_[a * n + b] lists the vertices of a on the wrong side of b.
+    // Written by the parallel scans, each task its own entries.
+    mutable std::vector<char> sides_scanned_;
+    mutable std::vector<std::vector<std::size_t>> wrong_side_;
     CheckReport report_;
 };
 

@@ -23,6 +23,12 @@ InputGapReport keep_input_gaps(Scene& scene, const InputGapParams& params) {
     validate(params);
     InputGapReport report;
     if (params.fraction == 0.0 || scene.size() < 2) return report;
+    // Only pairs that require nothing are raised: without one, no check is needed.
+    bool any_free_pair = false;
+    for (std::size_t a = 0; a < scene.size() && !any_free_pair; ++a)
+        for (std::size_t b = a + 1; b < scene.size() && !any_free_pair; ++b)
+            any_free_pair = !(scene.required_separation(a, b) > 0.0);
+    if (!any_free_pair) return report;
     CheckParams check_params;
     check_params.near_distance = params.near_distance;
     check_params.max_listed = 0;

@@ -115,21 +115,4 @@ Vec2 crossing_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& 
     return p0 + t * d;
 }
 
-double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b, Vec2* closest) {
-    const Vec2 d = b - a;
-    const double len2 = d.x * d.x + d.y * d.y;
-    Vec2 c = a;
-    if (len2 > 0.0) {
-        const Vec2 w = p - a;
-        const double t = (w.x * d.x + w.y * d.y) / len2;
-        if (t >= 1.0)
-            c = b;
-        else if (t > 0.0)
-            c = a + t * d;
-    }
-    if (closest) *closest = c;
-    const double dx = p.x - c.x, dy = p.y - c.y;
-    return std::sqrt(dx * dx + dy * dy);
-}
-
 }  // namespace strata

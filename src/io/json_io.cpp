@@ -126,9 +126,9 @@ class Reader {
                 layer.points.reserve(value.size());
                 for (std::size_t k = 0; k < value.size(); ++k) {
                     const json& p = value[k];
-                    const std::string pat = at + "[" + std::to_string(k) + "]";
                     if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
-                        fail(pat, "expected [x, y] with two numbers (got " + shown(p) + ")");
+                        fail(at + "[" + std::to_string(k) + "]",
+                             "expected [x, y] with two numbers (got " + shown(p) + ")");
                     layer.points.emplace_back(p[0].get<double>(), p[1].get<double>());
                 }
             } else {

@@ -23,6 +23,8 @@
 #include "strata/simplify/decimator.h"
 #include "untangle/detail/engine.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -128,8 +130,10 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
         r.target = live.layer(l).target;
         r.max_displacement = live.max_displacement(l);
         if (r.after > r.target) report.targets_met = false;
-        r.hausdorff = hausdorff(after, before, tolerance).symmetric();
     }
+    tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t l) {
+        report.layers[l].hausdorff = hausdorff(out.layer(l), scene.layer(l), tolerance).symmetric();
+    });
     report.seconds_check += seconds_since(start);
     scene = std::move(out);
     return report;

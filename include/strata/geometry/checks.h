@@ -116,8 +116,12 @@ struct CheckReport {
 /// layer is decided exactly (non-zero winding number with orient2d). Side-by-side pairs are
 /// not checked against open layers.
 ///
-/// Cost: rtree broad phases throughout, O((n + k) log n) for n segments and k contacts, plus
-/// one point-in-polygon ray query per vertex and closed layer whose box holds it.
+/// Cost: an rtree broad phase for the contacts, O((n + k) log n) for n segments and k
+/// contacts; a nearest-segment query in a per-layer uniform grid per vertex and near layer
+/// (one query serves both the separation and, against an open layer, the side); one
+/// point-in-polygon ray query per vertex and closed layer whose box holds it. Pairs of layers
+/// are scanned in parallel (TBB, within the caller's max_allowed_parallelism); the report
+/// does not depend on the number of threads.
 /// @throws InvalidInput bad params.
 CheckReport check_scene(const Scene& scene, const CheckParams& params = {});
 

@@ -6,6 +6,7 @@
 
 #include "strata/core/types.h"
 
+#include <cmath>
 #include <optional>
 
 namespace strata {
@@ -43,7 +44,24 @@ std::optional<int> winding_change_across(const Vec2& p0, const Vec2& p1, const V
 /// Intersection point of the supporting lines of two properly crossing segments (rounded).
 Vec2 crossing_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1);
 
-/// Distance from `p` to segment [a, b], and the closest point of the segment.
-double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b, Vec2* closest = nullptr);
+/// Distance from `p` to segment [a, b], and the closest point of the segment. Inline: the
+/// nearest-segment queries of the checks and the fields call it in their innermost loops.
+inline double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b,
+                                     Vec2* closest = nullptr) {
+    const Vec2 d = b - a;
+    const double len2 = d.x * d.x + d.y * d.y;
+    Vec2 c = a;
+    if (len2 > 0.0) {
+        const Vec2 w = p - a;
+        const double t = (w.x * d.x + w.y * d.y) / len2;
+        if (t >= 1.0)
+            c = b;
+        else if (t > 0.0)
+            c = a + t * d;
+    }
+    if (closest) *closest = c;
+    const double dx = p.x - c.x, dy = p.y - c.y;
+    return std::sqrt(dx * dx + dy * dy);
+}
 
 }  // namespace strata

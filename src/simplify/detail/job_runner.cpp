@@ -185,9 +185,8 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
 
 void JobRunner::execute(Job& job) const {
     SegmentGrid moving(live_.grid().cell());
-    std::vector<SegRef> found;
     auto is_ok = [&](const Scene& s) {
-        const Overlay ov(live_, slots_, job, s, moving, found);
+        const Overlay ov(live_, slots_, job, s, moving);
         moving.clear();
         for (const SegRef& seg : job.moving) {
             Box2 box;

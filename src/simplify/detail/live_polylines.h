@@ -54,10 +54,7 @@ class LivePolylines {
         return {static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(i)};
     }
 
-  private:
-    bool has_segment(std::size_t l, std::size_t i) const {
-        return layers_[l].alive[i] && layers_[l].next[i] != kNone;
-    }
+    /// The box segment (l, i) is filed with in grid(): its end points' box.
     Box2 seg_box(std::size_t l, std::size_t i) const {
         Box2 box;
         box.extend(layers_[l].pos[i]);
@@ -65,6 +62,10 @@ class LivePolylines {
         return box;
     }
 
+  private:
+    bool has_segment(std::size_t l, std::size_t i) const {
+        return layers_[l].alive[i] && layers_[l].next[i] != kNone;
+    }
     std::vector<WorkLayer> layers_;
     SegmentGrid grid_;
     std::vector<std::vector<std::uint32_t>> stamp_;  // per segment: last segments_near() to meet it

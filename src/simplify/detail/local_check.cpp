@@ -3,6 +3,7 @@
 #include "strata/geometry/predicates.h"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 namespace strata::detail {
@@ -18,6 +19,17 @@ double segment_distance(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Ve
     return std::min(
         std::min(point_segment_distance(p0, q0, q1), point_segment_distance(p1, q0, q1)),
         std::min(point_segment_distance(q0, p0, p1), point_segment_distance(q1, p0, p1)));
+}
+
+// The boxes are more than `d` apart along x or y, by a margin far above the rounding of the
+// subtraction: then no point of one is within d of a point of the other.
+bool apart_by_more(const Box2& a, const Box2& b, double d) {
+    const double gap =
+        std::max({a.min.x - b.max.x, b.min.x - a.max.x, a.min.y - b.max.y, b.min.y - a.max.y});
+    const double scale =
+        std::max({std::abs(a.min.x), std::abs(a.max.x), std::abs(a.min.y), std::abs(a.max.y),
+                  std::abs(b.min.x), std::abs(b.max.x), std::abs(b.min.y), std::abs(b.max.y)});
+    return gap > d + 1e-12 * scale;
 }
 
 }  // namespace
@@ -40,12 +52,17 @@ bool LocalCheck::segment_clear(std::size_t l, std::size_t a, std::size_t b,
         const std::size_t u2 = live_.layer(k).next[u];
         if (k == l && (u == a || u == b || u2 == a || u2 == b)) return;
         const Vec2 s0 = ov.pos(k, u), s1 = ov.pos(k, u2);
-        if (segment_contact(p, q, s0, s1) != SegmentContact::None) {
+        Box2 other;
+        other.extend(s0);
+        other.extend(s1);
+        // Segments meet only where their boxes do (exact comparisons).
+        if (other.overlaps(box) && segment_contact(p, q, s0, s1) != SegmentContact::None) {
             ok = false;
             return;
         }
         const double need = separations_.need[l][k];
-        if (k != l && need > 0.0 && segment_distance(p, q, s0, s1) < need) ok = false;
+        if (k == l || !(need > 0.0) || apart_by_more(box, other, need)) return;
+        if (segment_distance(p, q, s0, s1) < need) ok = false;
     });
     return ok;
 }

@@ -4,6 +4,7 @@
 
 #include "strata/core/types.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -65,6 +66,24 @@ class SegmentGrid {
             const std::vector<SegRef>* v = find(ix, iy);
             if (!v) return;
             for (const SegRef& s : *v) f(s);
+        });
+    }
+
+    // Calls f(SegRef) once per segment whose box meets `box`, without marking anything: a
+    // segment is reported only from the cell holding the lower-left corner of the two boxes'
+    // intersection. box_of(s) must give the box s was inserted with.
+    template <class BoxOf, class F>
+    void query_once(const Box2& box, BoxOf&& box_of, F&& f) const {
+        for_cells(box, [&](long long ix, long long iy) {
+            const std::vector<SegRef>* v = find(ix, iy);
+            if (!v) return;
+            for (const SegRef& s : *v) {
+                const Box2 b = box_of(s);
+                if (!b.overlaps(box) || coord(std::max(b.min.x, box.min.x)) != ix ||
+                    coord(std::max(b.min.y, box.min.y)) != iy)
+                    continue;
+                f(s);
+            }
         });
     }
 

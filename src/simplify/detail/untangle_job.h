@@ -83,16 +83,11 @@ class Overlay {
     /// The live positions. near() marks the segments it meets (LivePolylines::segments_near).
     explicit Overlay(LivePolylines& live) : live_(&live), marking_(&live) {}
     /// Over `job`'s runs, the positions of `work` (its work scene while it runs); `moving`:
-    /// the job's moving segments where they are in `work`; `found`: scratch for near(). Writes
-    /// nothing the live polylines share: the jobs of a batch run side by side.
+    /// the job's moving segments where they are in `work` (filed with their boxes there).
+    /// Writes nothing the live polylines share: the jobs of a batch run side by side.
     Overlay(const LivePolylines& live, const JobSlots& slots, const Job& job, const Scene& work,
-            const SegmentGrid& moving, std::vector<SegRef>& found)
-        : live_(&live),
-          slots_(&slots),
-          job_(&job),
-          work_(&work),
-          moving_(&moving),
-          found_(&found) {}
+            const SegmentGrid& moving)
+        : live_(&live), slots_(&slots), job_(&job), work_(&work), moving_(&moving) {}
 
     /// The job read through, if any.
     const Job* job() const { return job_; }
@@ -110,24 +105,25 @@ class Overlay {
             marking_->segments_near(box, f);
             return;
         }
-        std::vector<SegRef>& found = *found_;
-        found.clear();
-        live_->grid().query(box, [&](SegRef s) {  // it holds the moving ones where they were
-            if (!slots_->is_free(s.layer, s.start, *job_) &&
-                !slots_->is_free(s.layer, live_->layer(s.layer).next[s.start], *job_))
-                found.push_back(s);
-        });
-        moving_->query(box, [&](SegRef s) { found.push_back(s); });
-        auto key = [](const SegRef& s) {
-            return (static_cast<std::uint64_t>(s.layer) << 32) | s.start;
-        };
-        std::sort(found.begin(), found.end(),
-                  [&](const SegRef& x, const SegRef& y) { return key(x) < key(y); });
-        found.erase(std::unique(found.begin(), found.end(),
-                                [&](const SegRef& x, const SegRef& y) { return key(x) == key(y); }),
-                    found.end());
-        for (const SegRef& s : found)
-            f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+        // The live grid holds the moving segments where they were: they come from `moving`.
+        live_->grid().query_once(
+            box, [&](SegRef s) { return live_->seg_box(s.layer, s.start); },
+            [&](SegRef s) {
+                if (!slots_->is_free(s.layer, s.start, *job_) &&
+                    !slots_->is_free(s.layer, live_->layer(s.layer).next[s.start], *job_))
+                    f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+            });
+        moving_->query_once(
+            box,
+            [&](SegRef s) {
+                Box2 b;
+                b.extend(pos(s.layer, s.start));
+                b.extend(pos(s.layer, live_->layer(s.layer).next[s.start]));
+                return b;
+            },
+            [&](SegRef s) {
+                f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+            });
     }
 
   private:
@@ -137,7 +133,6 @@ class Overlay {
     const Job* job_ = nullptr;
     const Scene* work_ = nullptr;
     const SegmentGrid* moving_ = nullptr;
-    std::vector<SegRef>* found_ = nullptr;
 };
 
 }  // namespace strata::detail
