@@ -10,7 +10,12 @@ if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
 endif()
 
 add_library(strata_sanitize INTERFACE)
-if(STRATA_SANITIZE)
+if(STRATA_FUZZ)
+  # Coverage for libFuzzer in every module; the fuzz targets link -fsanitize=fuzzer.
+  target_compile_options(strata_sanitize INTERFACE -fsanitize=fuzzer-no-link,address,undefined
+    -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(strata_sanitize INTERFACE -fsanitize=address,undefined)
+elseif(STRATA_SANITIZE)
   target_compile_options(strata_sanitize INTERFACE
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(strata_sanitize INTERFACE -fsanitize=address,undefined)

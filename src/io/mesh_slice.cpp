@@ -34,6 +34,7 @@
 #include <mutex>
 #include <numeric>
 #include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -499,7 +500,20 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
     for (std::size_t n = 1; std::getline(in, line); ++n)
         for (auto& t : line_tokens(line.substr(0, line.find('#')), n))
             tokens.push_back(std::move(t));
-    if (tokens.empty() || tokens[0].text != "OFF") return;  // other OFF variants: OpenMesh decides
+    if (tokens.empty()) return;
+    if (tokens[0].text != "OFF") {
+        // A variant (COFF, NOFF, STOFF, 4OFF, nOFF ...): OpenMesh decides. A variant's magic
+        // followed by other characters is refused: OpenMesh read "OFF\b0..." as OFF and
+        // allocated without bound for a face of -3 vertices (found by fuzz_mesh).
+        static const std::regex variant("(ST)?C?N?4?n?OFF");
+        static const std::regex prefixed("(ST)?C?N?4?n?OFF.+");
+        if (std::regex_match(tokens[0].text, prefixed) &&
+            !std::regex_match(tokens[0].text, variant))
+            mesh_text_error(path, tokens[0],
+                            "not an OFF header (got '" + shown_token(tokens[0].text) +
+                                "'; expected OFF, COFF, NOFF, STOFF, 4OFF, nOFF ...)");
+        return;
+    }
     std::size_t next = 1;
     auto take = [&](const char* what) -> const TextToken& {
         if (next >= tokens.size()) {
@@ -546,8 +560,75 @@ void validate_stl_text(const std::filesystem::path& path, std::istream& in) {
     }
 }
 
+// The PLY header, checked line by line before OpenMesh sees it: OpenMesh 9 loops forever on
+// some malformed headers (a format line whose version is not a number, found by fuzz_mesh).
+void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
+    static const std::set<std::string> types = {
+        "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+        "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    auto check_type = [&](const TextToken& t) {
+        if (types.count(t.text) == 0)
+            mesh_text_error(path, t, "unknown PLY property type '" + shown_token(t.text) + "'");
+    };
+    auto expect_count = [&](const std::vector<TextToken>& tokens, std::size_t count,
+                            const char* form) {
+        if (tokens.size() != count) {
+            TextToken at = tokens.back();
+            at.column += at.text.size();
+            mesh_text_error(path, at, std::string("expected '") + form + "'");
+        }
+    };
+    std::string line;
+    std::size_t n = 0;
+    bool format = false;
+    while (std::getline(in, line)) {
+        ++n;
+        const auto tokens = line_tokens(line, n);
+        if (n == 1) {
+            if (tokens.size() != 1 || tokens[0].text != "ply")
+                mesh_text_error(path, {tokens.empty() ? "" : tokens[0].text, 1, 1},
+                                "not a PLY file: the first line must be 'ply'");
+            continue;
+        }
+        if (tokens.empty()) continue;
+        const std::string& key = tokens[0].text;
+        if (key == "comment" || key == "obj_info") continue;
+        if (key == "end_header") {
+            if (!format) mesh_text_error(path, tokens[0], "the PLY header has no format line");
+            return;
+        }
+        if (key == "format") {
+            expect_count(tokens, 3, "format ascii|binary_little_endian|binary_big_endian 1.0");
+            if (tokens[1].text != "ascii" && tokens[1].text != "binary_little_endian" &&
+                tokens[1].text != "binary_big_endian")
+                mesh_text_error(path, tokens[1],
+                                "unknown PLY format '" + shown_token(tokens[1].text) + "'");
+            check_coordinate(path, tokens[2]);
+            format = true;
+        } else if (key == "element") {
+            expect_count(tokens, 3, "element NAME COUNT");
+            if (integer_token(path, tokens[2], tokens[2].text, "an element count") < 0)
+                mesh_text_error(path, tokens[2],
+                                "count is negative (got '" + tokens[2].text + "')");
+        } else if (key == "property") {
+            if (tokens.size() >= 2 && tokens[1].text == "list") {
+                expect_count(tokens, 5, "property list COUNT_TYPE TYPE NAME");
+                check_type(tokens[2]);
+                check_type(tokens[3]);
+            } else {
+                expect_count(tokens, 3, "property TYPE NAME");
+                check_type(tokens[1]);
+            }
+        } else {
+            mesh_text_error(path, tokens[0], "unknown PLY header line '" + shown_token(key) + "'");
+        }
+    }
+    mesh_text_error(path, {"", n, 1}, "the PLY header has no end_header line");
+}
+
 // Refuses non-finite coordinates and faces naming missing vertices in OBJ, plain OFF and ASCII
-// STL files, with the file's line and column; other files are left to OpenMesh.
+// STL files, and malformed PLY headers, with the file's line and column; the rest is left to
+// OpenMesh.
 void validate_mesh_text(const std::filesystem::path& path, const std::string& ext) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return;
@@ -557,6 +638,8 @@ void validate_mesh_text(const std::filesystem::path& path, const std::string& ex
         validate_off_text(path, in);
     else if (ext == ".stl")
         validate_stl_text(path, in);
+    else if (ext == ".ply")
+        validate_ply_header(path, in);
 }
 
 }  // namespace

@@ -948,12 +948,15 @@ Scene read_scene_svg(const std::filesystem::path& path, const SvgReadParams& par
 std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
     validate(params);
     const bool explicit_outer = !scene.is_implicit_stack();
+    // Only names that data-outer lists must be free of separators (an unlinked layer named
+    // " a" is written as it is: fuzz_svg read such an id and could not write it back).
     if (explicit_outer)
-        for (const Layer& layer : scene.layers())
-            if (layer.name.find_first_of(", \t\n\r\f") != std::string::npos)
-                throw InvalidInput("scene_to_svg: layer '" + layer.name +
-                                   "': a name with a space or comma cannot be written in "
-                                   "data-outer");
+        for (std::size_t i = 0; i < scene.size(); ++i)
+            for (const std::size_t j : scene.outer_of(i))
+                if (scene.layer(j).name.find_first_of(", \t\n\r\f") != std::string::npos)
+                    throw InvalidInput("scene_to_svg: layer '" + scene.layer(j).name +
+                                       "': a name with a space or comma cannot be written in "
+                                       "data-outer");
 
     Box2 box = scene.bounds();
     if (params.underlay) box.extend(params.underlay->bounds());

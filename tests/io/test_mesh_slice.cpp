@@ -336,6 +336,46 @@ TEST_CASE("reading errors name the file", "[mesh_slice]") {
     CHECK(capture.err.str().empty());
 }
 
+TEST_CASE("malformed PLY and OFF headers are refused with line and column (fuzz_mesh)",
+          "[mesh_slice]") {
+    // OpenMesh 9 looped forever on "format ascii !.0" (fuzz/regressions/mesh).
+    const std::string body =
+        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 1\n0 1 1\n3 0 1 2\n";
+    auto write = [&](const std::string& name, const std::string& text) {
+        const auto path = temp_dir() / name;
+        std::ofstream(path, std::ios::binary) << text;
+        return path;
+    };
+    CaptureStd capture;
+    CHECK_THROWS_WITH(read_slice_mesh(write("version.ply", "ply\nformat ascii !.0\n" + body)),
+                      Contains("version.ply:2:14") && Contains("'!.0'"));
+    CHECK_THROWS_WITH(read_slice_mesh(write("kind.ply", "ply\nformat text 1.0\n" + body)),
+                      Contains("kind.ply:2:8") && Contains("'text'"));
+    CHECK_THROWS_WITH(
+        read_slice_mesh(write("keyword.ply", "ply\nformat ascii 1.0\nelemnt x 3\n" + body)),
+        Contains("keyword.ply:3:1") && Contains("'elemnt'"));
+    CHECK_THROWS_WITH(read_slice_mesh(write("type.ply",
+                                            "ply\nformat ascii 1.0\nelement v 3\n"
+                                            "property flot x\nend_header\n")),
+                      Contains("type.ply:4:10") && Contains("'flot'"));
+    CHECK_THROWS_WITH(read_slice_mesh(write("end.ply", "ply\nformat ascii 1.0\nelement v 3\n")),
+                      Contains("end.ply") && Contains("end_header"));
+    CHECK_THROWS_WITH(read_slice_mesh(write("magic.ply", "plx\nformat ascii 1.0\n" + body)),
+                      Contains("magic.ply:1:1") && Contains("'ply'"));
+    // An OFF magic followed by other characters (OpenMesh took it for OFF and allocated without
+    // bound for a face of -3 vertices; fuzz/regressions/mesh).
+    CHECK_THROWS_WITH(read_slice_mesh(write("magic.off", std::string("OFF\b0\n1 1 0\n0 0 0\n"
+                                                                     "-3 1 2 4\n"))),
+                      Contains("magic.off:1:1") && Contains("not an OFF header"));
+    // A valid header still reads (CRLF line ends and comments included).
+    const SliceMesh ok = read_slice_mesh(
+        write("ok.ply", "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\n" + body));
+    CHECK(ok.triangles.size() == 1);
+    CHECK(capture.err.str().empty());
+}
+
 TEST_CASE("nesting: nested cylinders, side by side inside a third", "[mesh_slice]") {
     SliceParams params;
     params.heights = {0.5};
