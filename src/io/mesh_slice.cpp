@@ -428,8 +428,22 @@ std::vector<TextToken> line_tokens(const std::string& line, std::size_t line_num
                        std::to_string(at.column) + ": " + what);
 }
 
+// A token for an error message: at most 40 characters, bytes outside printable ASCII as \xNN
+// (binary junk would cut or garble the one-line message).
 std::string shown_token(const std::string& text) {
-    return text.size() > 40 ? text.substr(0, 37) + "..." : text;
+    std::string out;
+    for (std::size_t i = 0; i < text.size() && out.size() < 37; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c >= 0x20 && c < 0x7f) {
+            out += static_cast<char>(c);
+        } else {
+            static const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        }
+    }
+    return out.size() < text.size() ? out + "..." : out;
 }
 
 // A finite coordinate, or an error naming the token.
@@ -437,7 +451,8 @@ void check_coordinate(const std::filesystem::path& path, const TextToken& t) {
     const char* begin = t.text.c_str();
     char* end = nullptr;
     const double v = std::strtod(begin, &end);
-    if (end == begin || *end != '\0')
+    // The whole token: an embedded NUL would end the C string early.
+    if (end == begin || end != begin + t.text.size())
         mesh_text_error(path, t, "expected a number (got '" + shown_token(t.text) + "')");
     if (!std::isfinite(v))
         mesh_text_error(path, t, "coordinate is not finite (got '" + shown_token(t.text) + "')");
@@ -450,7 +465,7 @@ long long integer_token(const std::filesystem::path& path, const TextToken& t,
     char* end = nullptr;
     errno = 0;
     const long long v = std::strtoll(begin, &end, 10);
-    if (end == begin || *end != '\0' || errno == ERANGE)
+    if (end == begin || end != begin + text.size() || errno == ERANGE)
         mesh_text_error(path, t,
                         std::string("expected ") + what + " (got '" + shown_token(t.text) + "')");
     return v;
@@ -502,13 +517,11 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
             tokens.push_back(std::move(t));
     if (tokens.empty()) return;
     if (tokens[0].text != "OFF") {
-        // A variant (COFF, NOFF, STOFF, 4OFF, nOFF ...): OpenMesh decides. A variant's magic
-        // followed by other characters is refused: OpenMesh read "OFF\b0..." as OFF and
+        // A variant (COFF, NOFF, STOFF, 4OFF, nOFF ...): OpenMesh reads the rest. Anything
+        // else is refused: OpenMesh read "OFF\b0..." and "\x01OFF 1 0 0\0..." as OFF and
         // allocated without bound for a face of -3 vertices (found by fuzz_mesh).
         static const std::regex variant("(ST)?C?N?4?n?OFF");
-        static const std::regex prefixed("(ST)?C?N?4?n?OFF.+");
-        if (std::regex_match(tokens[0].text, prefixed) &&
-            !std::regex_match(tokens[0].text, variant))
+        if (!std::regex_match(tokens[0].text, variant))
             mesh_text_error(path, tokens[0],
                             "not an OFF header (got '" + shown_token(tokens[0].text) +
                                 "'; expected OFF, COFF, NOFF, STOFF, 4OFF, nOFF ...)");
