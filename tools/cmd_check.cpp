@@ -27,20 +27,6 @@ struct CheckOptions {
     double hausdorff_tolerance = 1e-9;
 };
 
-const char* relation_name(Relation r) {
-    switch (r) {
-        case Relation::Same:
-            return "same";
-        case Relation::Under:
-            return "under";
-        case Relation::Over:
-            return "over";
-        case Relation::SideBySide:
-            return "side-by-side";
-    }
-    return "?";
-}
-
 std::string num(double v) {
     if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
     char buf[32];

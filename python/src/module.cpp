@@ -95,6 +95,26 @@ std::size_t whole(const py::handle& v, const char* name, std::size_t min) {
     return static_cast<std::size_t>(x);
 }
 
+// The untangling keyword arguments strata.simplify() and strata.untangle() share: true when
+// `key` is one of them (and `u` is set).
+bool untangle_option(UntangleParams& u, const std::string& key, const py::handle& v) {
+    if (key == "backend")
+        u.field.backend = parse_backend(v.cast<std::string>());
+    else if (key == "alpha")
+        u.alpha = v.cast<double>();
+    else if (key == "beta")
+        u.beta = v.cast<double>();
+    else if (key == "gradient_steps")
+        u.gradient_steps = v.cast<int>();
+    else if (key == "tolerance")
+        u.tolerance = v.cast<double>();
+    else if (key == "max_rounds")
+        u.max_rounds = v.cast<int>();
+    else
+        return false;
+    return true;
+}
+
 // The simplify options from the keyword arguments (names as in strata.simplify()).
 cli::SimplifyOptions simplify_options(const py::dict& kw) {
     cli::SimplifyOptions o;
@@ -126,18 +146,8 @@ cli::SimplifyOptions simplify_options(const py::dict& kw) {
                 p.schedule = UntangleSchedule::Immediate;
             else
                 throw InvalidInput("schedule: '" + s + "' not in {deferred, immediate}");
-        } else if (key == "backend")
-            u.field.backend = parse_backend(v.cast<std::string>());
-        else if (key == "alpha")
-            u.alpha = v.cast<double>();
-        else if (key == "beta")
-            u.beta = v.cast<double>();
-        else if (key == "gradient_steps")
-            u.gradient_steps = v.cast<int>();
-        else if (key == "tolerance")
-            u.tolerance = v.cast<double>();
-        else if (key == "max_rounds")
-            u.max_rounds = v.cast<int>();
+        } else if (untangle_option(u, key, v))
+            continue;
         else if (key == "thickness")
             o.thickness = v.cast<double>();
         else if (key == "keep_gaps")
@@ -311,17 +321,7 @@ PYBIND11_MODULE(_strata, m) {
         .def(
             "relation",
             [](const Scene& s, std::size_t a, std::size_t b) {
-                switch (s.relation(a, b)) {
-                    case Relation::Same:
-                        return "same";
-                    case Relation::Under:
-                        return "under";
-                    case Relation::Over:
-                        return "over";
-                    case Relation::SideBySide:
-                        return "side-by-side";
-                }
-                return "?";
+                return relation_name(s.relation(a, b));
             },
             py::arg("a"), py::arg("b"))
         .def(
@@ -443,18 +443,8 @@ PYBIND11_MODULE(_strata, m) {
             const std::string key = py::str(item.first);
             const py::handle v = item.second;
             if (v.is_none()) continue;
-            if (key == "backend")
-                u.field.backend = parse_backend(v.cast<std::string>());
-            else if (key == "alpha")
-                u.alpha = v.cast<double>();
-            else if (key == "beta")
-                u.beta = v.cast<double>();
-            else if (key == "gradient_steps")
-                u.gradient_steps = v.cast<int>();
-            else if (key == "tolerance")
-                u.tolerance = v.cast<double>();
-            else if (key == "max_rounds")
-                u.max_rounds = v.cast<int>();
+            if (untangle_option(u, key, v))
+                continue;
             else if (key == "max_passes")
                 u.max_passes = v.cast<int>();
             else if (key == "shape_matching") {

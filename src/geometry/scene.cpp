@@ -11,6 +11,20 @@
 
 namespace strata {
 
+const char* relation_name(Relation r) {
+    switch (r) {
+        case Relation::Same:
+            return "same";
+        case Relation::Under:
+            return "under";
+        case Relation::Over:
+            return "over";
+        case Relation::SideBySide:
+            return "side-by-side";
+    }
+    return "?";
+}
+
 namespace {
 
 std::string layer_label(const Layer& layer, std::size_t index) {

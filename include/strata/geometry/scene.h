@@ -21,6 +21,9 @@ enum class Relation {
     SideBySide,  ///< Neither is under the other; neither may enter the other.
 };
 
+/// "same", "under", "over" or "side-by-side" (the names of reports and messages).
+const char* relation_name(Relation r);
+
 /// What the scene's validation changed or noticed without rejecting the input.
 struct SceneDiagnostics {
     std::size_t removed_duplicates = 0;  ///< Exact consecutive duplicate points removed.
