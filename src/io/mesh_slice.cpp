@@ -525,8 +525,8 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
             mesh_text_error(path, tokens[0],
                             "not an OFF header (got '" + shown_token(tokens[0].text) +
                                 "'; expected OFF, COFF, NOFF, STOFF, 4OFF, nOFF ...)");
-        return;
     }
+    const bool plain = tokens[0].text == "OFF";
     std::size_t next = 1;
     auto take = [&](const char* what) -> const TextToken& {
         if (next >= tokens.size()) {
@@ -536,11 +536,51 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
         }
         return tokens[next++];
     };
+    if (tokens[0].text.find('n') != std::string::npos) {
+        const TextToken& t = take("the dimension of an nOFF file");
+        integer_token(path, t, t.text, "a dimension");
+    }
+    if (next < tokens.size() && tokens[next].text == "BINARY")
+        mesh_text_error(path, tokens[next],
+                        "binary OFF is not supported (write it as ASCII OFF, OBJ or PLY)");
     long long counts[3] = {0, 0, 0};
     for (long long& c : counts) {
         const TextToken& t = take("the vertex, face and edge counts");
         c = integer_token(path, t, t.text, "a count");
         if (c < 0) mesh_text_error(path, t, "count is negative (got '" + t.text + "')");
+    }
+    if (!plain) {
+        // A variant's vertex lines carry colours, normals or texture coordinates (nOFF: any
+        // number of coordinates), so only a bound is checked here: every vertex and every face
+        // takes at least one token. OpenMesh would otherwise reserve and loop over any count
+        // (a 70-byte NOFF file claiming 2e8 faces took 11 GB; found by fuzz_mesh).
+        const auto left = static_cast<long long>(tokens.size() - next);
+        for (int k = 0; k < 2; ++k)
+            if (counts[k] > left) {
+                const TextToken& at = tokens[next - 3 + static_cast<std::size_t>(k)];
+                mesh_text_error(path, at,
+                                "count " + at.text + " is more than the file holds (" +
+                                    std::to_string(left) + " values follow the counts)");
+            }
+        // Faces: skip one line per vertex, then a face's size (its line's first token) is
+        // bounded the same way: OpenMesh sizes a face's index list from it.
+        std::size_t at = next;
+        for (long long v = 0; v < counts[0] && at < tokens.size(); ++v) {
+            const std::size_t line_number = tokens[at].line;
+            while (at < tokens.size() && tokens[at].line == line_number) ++at;
+        }
+        for (long long f = 0; f < counts[1] && at < tokens.size(); ++f) {
+            const TextToken& t = tokens[at];
+            char* end = nullptr;
+            const long long size = std::strtoll(t.text.c_str(), &end, 10);
+            if (*end == '\0' && size > static_cast<long long>(tokens.size() - at))
+                mesh_text_error(path, t,
+                                "face size " + t.text + " is more than the file holds (" +
+                                    std::to_string(tokens.size() - at - 1) + " values follow)");
+            const std::size_t line_number = t.line;
+            while (at < tokens.size() && tokens[at].line == line_number) ++at;
+        }
+        return;
     }
     for (long long v = 0; v < counts[0]; ++v)
         for (int k = 0; k < 3; ++k) check_coordinate(path, take("a vertex coordinate"));
@@ -579,6 +619,8 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
     static const std::set<std::string> types = {
         "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
         "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    std::error_code ec;
+    const auto file_size = static_cast<long long>(std::filesystem::file_size(path, ec));
     auto check_type = [&](const TextToken& t) {
         if (types.count(t.text) == 0)
             mesh_text_error(path, t, "unknown PLY property type '" + shown_token(t.text) + "'");
@@ -620,9 +662,16 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
             format = true;
         } else if (key == "element") {
             expect_count(tokens, 3, "element NAME COUNT");
-            if (integer_token(path, tokens[2], tokens[2].text, "an element count") < 0)
+            const long long count =
+                integer_token(path, tokens[2], tokens[2].text, "an element count");
+            if (count < 0)
                 mesh_text_error(path, tokens[2],
                                 "count is negative (got '" + tokens[2].text + "')");
+            // Every element takes at least one byte (binary) or one token (ASCII).
+            if (count > file_size)
+                mesh_text_error(path, tokens[2],
+                                "count " + tokens[2].text + " is more than the file holds (" +
+                                    std::to_string(file_size) + " bytes)");
         } else if (key == "property") {
             if (tokens.size() >= 2 && tokens[1].text == "list") {
                 expect_count(tokens, 5, "property list COUNT_TYPE TYPE NAME");
