@@ -6,7 +6,6 @@
 #include <cstring>
 #include <fstream>
 #include <random>
-#include <sstream>
 #include <system_error>
 
 namespace strata {
@@ -19,10 +18,22 @@ std::string read_text_file(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in)
         throw IoError(path.string() + ": cannot open for reading (" + std::strerror(errno) + ")");
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
+    // Sized from the file when it has a size, then read in chunks to its end. (Streaming into an
+    // ostringstream copied the text twice, and swallowed an out-of-memory error, leaving a
+    // truncated text.)
+    std::string text;
+    constexpr std::size_t kChunk = std::size_t{1} << 20;
+    const auto size = fs::file_size(path, ec);
+    if (!ec) text.reserve(static_cast<std::size_t>(size) + kChunk);  // room for the last read
+    for (;;) {
+        const std::size_t at = text.size();
+        text.resize(at + kChunk);
+        in.read(&text[at], static_cast<std::streamsize>(kChunk));
+        text.resize(at + static_cast<std::size_t>(in.gcount()));
+        if (!in) break;
+    }
     if (in.bad()) throw IoError(path.string() + ": read failed");
-    return buffer.str();
+    return text;
 }
 
 void write_file_atomic(const fs::path& path, std::string_view content) {

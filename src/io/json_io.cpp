@@ -7,7 +7,11 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <map>
+#include <set>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace strata {
 
@@ -63,6 +67,228 @@ std::string shown(const json& value) {
     if (text.size() > 60) text = text.substr(0, 57) + "...";
     return text;
 }
+
+// The common case read without a document tree: nlohmann's SAX interface fills the layers
+// directly, so a large scene costs its points and nothing more (the tree took about 10 times
+// the memory of the points, and an allocation failure while the tree was being torn down
+// aborted the process). Anything this reader does not accept as it stands (a syntax error, a
+// wrong type, a duplicate key, a missing key) makes it give up, and the document-tree reader
+// below reads the text again to name the problem exactly. Unknown keys are captured into a
+// small tree each and kept as their JSON text, as the tree reader keeps them.
+class SceneSax {
+  public:
+    using number_integer_t = json::number_integer_t;
+    using number_unsigned_t = json::number_unsigned_t;
+    using number_float_t = json::number_float_t;
+    using string_t = json::string_t;
+    using binary_t = json::binary_t;
+
+    /// What was read; valid after a successful json::sax_parse().
+    bool has_layers = false;
+    std::string units;
+    std::map<std::string, std::string> metadata;
+    std::vector<Layer> layers;
+
+    bool null() { return value(json(nullptr)); }
+    bool boolean(bool v) { return value(json(v)); }
+    bool number_integer(number_integer_t v) { return value(json(v)); }
+    bool number_unsigned(number_unsigned_t v) { return value(json(v)); }
+    bool number_float(number_float_t v, const string_t&) { return value(json(v)); }
+    bool string(string_t& v) { return value(json(std::move(v))); }
+    bool binary(binary_t&) { return false; }
+
+    bool start_object(std::size_t) {
+        if (capturing()) return open(json::object());
+        if (at_.empty()) {
+            at_.push_back(At::Root);
+            return true;
+        }
+        if (at_.back() == At::Layers) {
+            at_.push_back(At::Layer);
+            layer_keys_.clear();
+            layers.emplace_back();
+            layers.back().name = "layer_" + std::to_string(layers.size() - 1);
+            return true;
+        }
+        if (unknown_key()) return open(json::object());
+        return false;
+    }
+    bool end_object() {
+        if (capturing()) return close();
+        if (at_.back() == At::Layer && layer_keys_.count("points") == 0) return false;
+        at_.pop_back();
+        return true;
+    }
+    bool key(string_t& k) {
+        if (capturing()) {
+            capture_key_ = k;
+            return true;
+        }
+        std::set<std::string>& seen = at_.back() == At::Root ? root_keys_ : layer_keys_;
+        if (!seen.insert(k).second) return false;  // a duplicate: the tree reader decides
+        key_ = k;
+        return true;
+    }
+    bool start_array(std::size_t) {
+        if (capturing()) return open(json::array());
+        switch (at_.empty() ? At::Root : at_.back()) {
+            case At::Root:
+                if (at_.empty()) return false;
+                if (key_ == "layers") {
+                    has_layers = true;
+                    at_.push_back(At::Layers);
+                    return true;
+                }
+                break;
+            case At::Layer:
+                if (key_ == "points" || key_ == "outer") {
+                    at_.push_back(key_ == "points" ? At::Points : At::Outer);
+                    if (key_ == "outer") layers.back().outer.emplace();
+                    return true;
+                }
+                break;
+            case At::Points:
+                at_.push_back(At::Point);
+                coordinates_ = 0;
+                return true;
+            default:
+                return false;
+        }
+        return unknown_key() && open(json::array());
+    }
+    bool end_array() {
+        if (capturing()) return close();
+        if (at_.back() == At::Point) {
+            if (coordinates_ != 2) return false;
+            layers.back().points.emplace_back(xy_[0], xy_[1]);
+        }
+        at_.pop_back();
+        return true;
+    }
+    /// A syntax error (or a number out of range): what nlohmann's own parser would throw.
+    bool syntax_error = false;
+    int error_id = 0;
+    std::size_t error_byte = 0;
+    std::string error_message;
+    bool parse_error(std::size_t position, const std::string&,
+                     const nlohmann::detail::exception& ex) {
+        syntax_error = true;
+        error_id = ex.id;
+        error_byte = position;
+        error_message = ex.what();
+        return false;
+    }
+
+  private:
+    enum class At { Root, Layers, Layer, Points, Point, Outer };
+
+    bool capturing() const { return !capture_.empty(); }
+
+    // The value of the current key is not one strata knows: it is captured.
+    bool unknown_key() const {
+        if (at_.back() == At::Root) return key_ != "strata" && key_ != "units" && key_ != "layers";
+        if (at_.back() == At::Layer)
+            return key_ != "name" && key_ != "closed" && key_ != "thickness" && key_ != "weight" &&
+                   key_ != "alpha" && key_ != "beta" && key_ != "outer" && key_ != "points";
+        return false;
+    }
+
+    // Captured values: a stack of the open containers, the outermost first.
+    bool open(json container) {
+        if (!capturing()) {
+            capture_.push_back(std::move(container));
+            return true;
+        }
+        capture_.push_back(std::move(container));
+        capture_keys_.push_back(capture_key_);
+        return true;
+    }
+    bool close() {
+        json done = std::move(capture_.back());
+        capture_.pop_back();
+        if (capturing()) {
+            const std::string k = std::move(capture_keys_.back());
+            capture_keys_.pop_back();
+            add(std::move(done), k);
+            return true;
+        }
+        keep(done.dump());
+        return true;
+    }
+    void add(json v, const std::string& k) {
+        json& parent = capture_.back();
+        if (parent.is_array())
+            parent.push_back(std::move(v));
+        else
+            parent[k] = std::move(v);
+    }
+    void keep(std::string text) {
+        if (at_.back() == At::Root)
+            metadata.emplace(key_, std::move(text));
+        else
+            layers.back().extra.emplace(key_, std::move(text));
+    }
+
+    bool value(json v) {
+        if (capturing()) {
+            add(std::move(v), capture_key_);
+            return true;
+        }
+        if (at_.empty()) return false;  // a top level that is not an object
+        Layer* layer = layers.empty() ? nullptr : &layers.back();
+        switch (at_.back()) {
+            case At::Root:
+                if (key_ == "strata") return v.is_number_integer() && v.get<long long>() == 1;
+                if (key_ == "units") {
+                    if (!v.is_string()) return false;
+                    units = v.get<std::string>();
+                    return true;
+                }
+                if (key_ == "layers") return false;
+                keep(v.dump());
+                return true;
+            case At::Layer:
+                if (key_ == "name") {
+                    if (!v.is_string()) return false;
+                    layer->name = v.get<std::string>();
+                } else if (key_ == "closed") {
+                    if (!v.is_boolean()) return false;
+                    layer->closed = v.get<bool>();
+                } else if (key_ == "thickness" || key_ == "weight") {
+                    if (!v.is_number()) return false;
+                    (key_ == "weight" ? layer->weight : layer->thickness) = v.get<double>();
+                } else if (key_ == "alpha" || key_ == "beta") {
+                    if (v.is_null()) return true;
+                    if (!v.is_number()) return false;
+                    (key_ == "alpha" ? layer->alpha : layer->beta) = v.get<double>();
+                } else if (key_ == "outer" || key_ == "points") {
+                    return false;
+                } else {
+                    keep(v.dump());
+                }
+                return true;
+            case At::Point:
+                if (!v.is_number() || coordinates_ == 2) return false;
+                xy_[coordinates_++] = v.get<double>();
+                return true;
+            case At::Outer:
+                if (!v.is_string()) return false;
+                layer->outer->push_back(v.get<std::string>());
+                return true;
+            default:
+                return false;  // a bare value in "layers" or "points"
+        }
+    }
+
+    std::vector<At> at_;
+    std::string key_;
+    std::set<std::string> root_keys_, layer_keys_;
+    double xy_[2] = {0.0, 0.0};
+    int coordinates_ = 0;
+    std::vector<json> capture_;
+    std::vector<std::string> capture_keys_;
+    std::string capture_key_;
+};
 
 class Reader {
   public:
@@ -147,31 +373,24 @@ class Reader {
                                std::to_string(kMaxJsonDepth) + " levels (found '" +
                                std::string(1, text[deep]) + "')");
         }
+        SceneSax sax;
+        const bool read = json::sax_parse(text.begin(), text.end(), &sax);
+        if (read && sax.has_layers && !sax.layers.empty())
+            return finish(std::move(sax.layers), sax.units, std::move(sax.metadata));
+        if (sax.syntax_error) {
+            // nlohmann's ids: 1xx syntax errors (with the byte), 4xx e.g. a number too large.
+            if (sax.error_id >= 100 && sax.error_id < 200)
+                syntax_failure(text, sax.error_message, sax.error_byte);
+            value_failure(text, sax.error_message);
+        }
+        // A content error: the document tree names it (its path, key and value).
         json root;
         try {
             root = json::parse(text.begin(), text.end());
         } catch (const json::parse_error& e) {
-            const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
-            const auto [line, column] = line_column(text, offset);
-            std::string message = e.what();
-            if (auto pos = message.find("syntax error"); pos != std::string::npos)
-                message = message.substr(pos);
-            throw InvalidInput(source_ + ":" + std::to_string(line) + ":" + std::to_string(column) +
-                               ": invalid JSON: " + message);
-        } catch (const json::exception& e) {  // e.g. a number too large for a double
-            // nlohmann names the number ("... parsing '1e999'") but not where it is: find it.
-            const std::string message = e.what();
-            std::string where;
-            const std::size_t open = message.find("parsing '");
-            const std::size_t close = open == std::string::npos ? open : message.rfind('\'');
-            if (open != std::string::npos && close > open + 9) {
-                const std::string token = message.substr(open + 9, close - open - 9);
-                if (const std::size_t at = text.find(token); at != std::string_view::npos) {
-                    const auto [line, column] = line_column(text, at);
-                    where = ":" + std::to_string(line) + ":" + std::to_string(column);
-                }
-            }
-            throw InvalidInput(source_ + where + ": invalid JSON: " + message);
+            syntax_failure(text, e.what(), e.byte);
+        } catch (const json::exception& e) {
+            value_failure(text, e.what());
         }
         if (!root.is_object())
             fail("top level", "expected an object with \"layers\" (got " + shown(root) + ")");
@@ -198,7 +417,40 @@ class Reader {
         if (layers->empty()) fail("layers", "no layer");
         std::vector<Layer> parsed;
         for (std::size_t i = 0; i < layers->size(); ++i) parsed.push_back(layer((*layers)[i], i));
+        return finish(std::move(parsed), units, std::move(metadata));
+    }
 
+  private:
+    // A syntax error at byte `byte` (1-based, nlohmann's count) of `text`.
+    [[noreturn]] void syntax_failure(std::string_view text, std::string message,
+                                     std::size_t byte) const {
+        const auto [line, column] = line_column(text, byte > 0 ? byte - 1 : 0);
+        if (auto pos = message.find("syntax error"); pos != std::string::npos)
+            message = message.substr(pos);
+        throw InvalidInput(source_ + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                           ": invalid JSON: " + message);
+    }
+
+    // Another parse failure, e.g. a number too large for a double: nlohmann names the number
+    // ("... parsing '1e999'") but not where it is, so it is looked for.
+    [[noreturn]] void value_failure(std::string_view text, const std::string& message) const {
+        std::string where;
+        const std::size_t open = message.find("parsing '");
+        const std::size_t close = open == std::string::npos ? open : message.rfind('\'');
+        if (open != std::string::npos && close > open + 9) {
+            const std::string token = message.substr(open + 9, close - open - 9);
+            if (const std::size_t at = text.find(token); at != std::string_view::npos) {
+                const auto [line, column] = line_column(text, at);
+                where = ":" + std::to_string(line) + ":" + std::to_string(column);
+            }
+        }
+        throw InvalidInput(source_ + where + ": invalid JSON: " + message);
+    }
+
+    // The scene from what either reader read: checks of the scene itself, and a note listing
+    // the unknown keys kept.
+    Scene finish(std::vector<Layer> parsed, const std::string& units,
+                 std::map<std::string, std::string> metadata) const {
         std::vector<std::string> kept;
         for (const auto& [key, value] : metadata) kept.push_back("\"" + key + "\"");
         for (const Layer& l : parsed)
@@ -221,7 +473,6 @@ class Reader {
         return scene;
     }
 
-  private:
     std::string source_;
 };
 
