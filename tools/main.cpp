@@ -7,6 +7,7 @@
 #include <exception>
 #include <iostream>
 #include <map>
+#include <new>
 #include <string>
 
 int main(int argc, char** argv) {
@@ -43,6 +44,11 @@ int main(int argc, char** argv) {
         return 2;
     } catch (const strata::Cancelled& e) {
         std::cerr << "strata: error: " << e.what() << '\n';
+        return 1;
+    } catch (const std::bad_alloc&) {
+        // Outputs are written atomically at the end of a run, so none was.
+        std::cerr << "strata: error: out of memory: the input needs more memory than this "
+                     "process may use (machine or ulimit); nothing written\n";
         return 1;
     } catch (const std::exception& e) {
         std::cerr << "strata: error: internal: " << e.what() << '\n';

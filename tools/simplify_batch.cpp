@@ -16,6 +16,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 
 namespace strata::cli {
 
@@ -233,6 +234,8 @@ Outcome simplify_slice(const std::string& input, const std::string& output,
         write_scene(result, o.output);
         o.report = std::move(r.report);
         o.naive = std::move(r.naive);
+    } catch (const std::bad_alloc&) {
+        o.error = "out of memory: this slice needs more memory than the process may use";
     } catch (const std::exception& e) {
         o.error = e.what();
     }

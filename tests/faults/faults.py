@@ -5,12 +5,16 @@
                           new one (never partial), over many kills timed around the write.
   faults.py STRATA batch  a batch goes on past a slice that fails, names it, and writes the
                           others.
+  faults.py STRATA memory an input too large for the memory the process may use (RLIMIT_AS)
+                          ends with one "out of memory" error, exit 1, nothing written, an
+                          existing output untouched, in bounded time (no hang, no abort).
 
 Exit 0 when the property held; prints what it saw (kills, how many landed in the write).
 """
 import json
 import math
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -144,9 +148,74 @@ def batch_test(strata):
     print("batch: exit %d, %s" % (r.returncode, "ok" if not failures else "FAILED"))
     return 0 if not failures else 1
 
+def run_limited(cmd, limit, timeout=120):
+    """Runs cmd with its address space limited to `limit` bytes."""
+    def cap():
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    return subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                          preexec_fn=cap, timeout=timeout)
+
+
+def memory_test(strata):
+    work = tempfile.mkdtemp(prefix="strata-faults-")
+    small = os.path.join(work, "small.json")
+    big = os.path.join(work, "big.json")
+    out = os.path.join(work, "out.json")
+    big_scene(small, layers=2, points=200)
+    # The smallest address space (to 16 MiB) in which strata checks and simplifies a small
+    # scene: what it needs to start (libraries, threads) and a little work.
+    def works(limit):
+        return all(run_limited([strata, verb, small, "-o", out] if verb == "simplify" else
+                               [strata, verb, small], limit).returncode == 0
+                   for verb in ("check", "simplify"))
+    low, high = 16 << 20, 4096 << 20
+    if not works(high):
+        print("memory: strata does not run in 4 GiB of address space here; skipped")
+        return 77
+    while high - low > (16 << 20):
+        mid = (low + high) // 2
+        if works(mid):
+            high = mid
+        else:
+            low = mid
+    limit = high + (64 << 20)
+    # A scene whose text alone is about 90 MB: it cannot be read in 64 MiB more.
+    big_scene(big, layers=8, points=250000)
+    failures = []
+    old = b'{"strata": 1, "layers": [{"name": "old", "points": [[0, 0], [1, 0]]}]}\n'
+    for verb in ("check", "simplify"):
+        with open(out, "wb") as f:
+            f.write(old)
+        cmd = [strata, verb, big] + (["-o", out] if verb == "simplify" else [])
+        t = time.monotonic()
+        try:
+            r = run_limited(cmd, limit)
+        except subprocess.TimeoutExpired:
+            failures.append("%s: no end within 120 s" % verb)
+            continue
+        seconds = time.monotonic() - t
+        errors = [l for l in r.stderr.splitlines() if l.startswith("strata: error:")]
+        print("memory: %s under %d MiB: exit %d in %.2f s: %s" %
+              (verb, limit >> 20, r.returncode, seconds, r.stderr.strip()[:200]))
+        if r.returncode != 1:
+            failures.append("%s: exit %d (expected 1)" % (verb, r.returncode))
+        if len(errors) != 1 or "out of memory" not in errors[0]:
+            failures.append("%s: not one 'out of memory' error line" % verb)
+        with open(out, "rb") as f:
+            if f.read() != old:
+                failures.append("%s: the existing output was changed" % verb)
+    leftovers = [n for n in os.listdir(work) if n not in ("small.json", "big.json", "out.json")]
+    if leftovers:
+        failures.append("files left behind: %s" % leftovers)
+    for f in failures:
+        print("memory: " + f)
+    print("memory: %s" % ("ok" if not failures else "FAILED"))
+    return 0 if not failures else 1
+
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3 or sys.argv[2] not in ("kill", "batch"):
+    tests = {"kill": kill_test, "batch": batch_test, "memory": memory_test}
+    if len(sys.argv) != 3 or sys.argv[2] not in tests:
         print(__doc__)
         sys.exit(2)
-    sys.exit(kill_test(sys.argv[1]) if sys.argv[2] == "kill" else batch_test(sys.argv[1]))
+    sys.exit(tests[sys.argv[2]](sys.argv[1]))
