@@ -526,6 +526,14 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
                             "not an OFF header (got '" + shown_token(tokens[0].text) +
                                 "'; expected OFF, COFF, NOFF, STOFF, 4OFF, nOFF ...)");
     }
+    // OpenMesh takes the whole first line as the header and reads the counts from the next
+    // one: anything after the magic on its line would be skipped and the counts read from the
+    // wrong place ("OFF 0 0 0" made it reserve 45 GB; found by fuzz_mesh).
+    if (tokens.size() > 1 && tokens[1].line == tokens[0].line)
+        mesh_text_error(path, tokens[1],
+                        "the OFF header line must hold only '" + tokens[0].text +
+                            "' (the counts go on the next line; got '" +
+                            shown_token(tokens[1].text) + "')");
     const bool plain = tokens[0].text == "OFF";
     std::size_t next = 1;
     auto take = [&](const char* what) -> const TextToken& {
