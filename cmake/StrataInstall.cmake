@@ -20,9 +20,11 @@ install(DIRECTORY "${PROJECT_SOURCE_DIR}/include/strata"
         DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
 install(EXPORT strataTargets NAMESPACE strata:: DESTINATION "${STRATA_INSTALL_CMAKEDIR}")
 
+set(STRATA_INSTALL_LIBDIR "${CMAKE_INSTALL_LIBDIR}")  # where libstrata_field_grid.so goes
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/strataConfig.cmake.in"
   "${PROJECT_BINARY_DIR}/strataConfig.cmake"
-  INSTALL_DESTINATION "${STRATA_INSTALL_CMAKEDIR}")
+  INSTALL_DESTINATION "${STRATA_INSTALL_CMAKEDIR}"
+  PATH_VARS STRATA_INSTALL_LIBDIR)
 write_basic_package_version_file("${PROJECT_BINARY_DIR}/strataConfigVersion.cmake"
   COMPATIBILITY SameMinorVersion)
 install(FILES "${PROJECT_BINARY_DIR}/strataConfig.cmake"

@@ -9,6 +9,7 @@
 
 #include "field/detail/backends.h"
 #include "field/detail/grid_inspect.h"
+#include "field/detail/grid_module.h"
 #include "field/detail/segment_index.h"
 #include "field/detail/segment_store.h"
 #include "strata/core/error.h"
@@ -976,3 +977,25 @@ void write_vdb(const Scene& scene, const SceneFields& fields, const std::filesys
 }
 
 }  // namespace strata
+
+// The module's entry point (grid_module.h): grid_loader.cpp in the field module finds it with
+// dlsym() and calls the functions above through this table.
+extern "C" __attribute__((visibility("default"))) const strata::detail::GridModule*
+strata_grid_module_v1() {
+    static const strata::detail::GridModule table = [] {
+        namespace d = strata::detail;
+        d::GridModule m;
+        m.version = STRATA_GRID_MODULE_VERSION;
+        m.make_grid_fields = &d::make_grid_fields;
+        m.make_grid_field = &d::make_grid_field;
+        m.grid_sample_all = &d::grid_sample_all;
+        m.grid_total_stats = &d::grid_total_stats;
+        m.grids_identical = &d::grids_identical;
+        m.max_box_sampler_difference = &d::max_box_sampler_difference;
+        m.voxel_signs = &d::voxel_signs;
+        m.shared_leaf_count = &d::shared_leaf_count;
+        m.write_vdb = &strata::write_vdb;
+        return m;
+    }();
+    return &table;
+}
