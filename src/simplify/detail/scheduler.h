@@ -51,6 +51,7 @@ class Scheduler {
     DecimationView view(std::size_t l) const;
     bool removable(std::size_t l, std::size_t v) const;
     void push(std::size_t l, std::size_t v);
+    void push_untimed(std::size_t l, std::size_t v);
     void count(Outcome outcome, std::size_t l, std::size_t v);
     void count_call(std::size_t l);
     void conclude(std::size_t l, std::size_t v, bool kept);
