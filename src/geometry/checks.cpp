@@ -160,6 +160,15 @@ class SegmentIndex {
         cell_ids_.resize(cell_start_.back());
         std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
         for (std::size_t s : segments_) each_cell(s, [&](std::size_t c) { cell_ids_[fill[c]++] = s; });
+        // Boxes of kChunk consecutive entries (a chunk may run into the next cell: its box then
+        // holds more, still a lower bound for each of its segments). A cell holds many entries
+        // where the grid is coarse for its layer (a long dense curve in a large box: the cell
+        // count is bounded by 4 a segment), and whole chunks are then skipped.
+        chunk_boxes_.assign((cell_ids_.size() + kChunk - 1) / kChunk, Box2{});
+        for (std::size_t k = 0; k < cell_ids_.size(); ++k) {
+            chunk_boxes_[k / kChunk].extend(start(cell_ids_[k]));
+            chunk_boxes_[k / kChunk].extend(end(cell_ids_[k]));
+        }
     }
     static double glm_length(const Vec2& v) { return std::hypot(v.x, v.y); }
     long column(double x) const { return clamp_cell((x - origin_.min.x) / h_, nx_); }
@@ -177,14 +186,30 @@ class SegmentIndex {
         const double dx = std::max({x0 - p.x, 0.0, p.x - (x0 + h_)});
         const double dy = std::max({y0 - p.y, 0.0, p.y - (y0 + h_)});
         if (dx * dx + dy * dy > best.distance * best.distance) return;
-        for (std::size_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
-            const std::size_t s = cell_ids_[k];
-            Vec2 closest;
-            const double d = point_segment_distance(p, start(s), end(s), &closest);
-            if (d < best.distance || (d == best.distance && s < best.segment)) {
-                best.distance = d;
-                best.segment = s;
-                best.point = closest;
+        // The entries go by chunks of kChunk, each skipped whole when its box is farther than
+        // the best so far (slack 1e-12: rounding never skips a segment that could win).
+        const std::size_t end_entry = cell_start_[c + 1];
+        const bool by_chunks = end_entry - cell_start_[c] > 4 * kChunk;  // else plain
+        for (std::size_t k = cell_start_[c]; k < end_entry;) {
+            const std::size_t chunk = k / kChunk;
+            const std::size_t chunk_end =
+                by_chunks ? std::min(end_entry, (chunk + 1) * kChunk) : end_entry;
+            const Box2& box = chunk_boxes_[chunk];
+            const double bx = std::max({box.min.x - p.x, 0.0, p.x - box.max.x});
+            const double by = std::max({box.min.y - p.y, 0.0, p.y - box.max.y});
+            if (by_chunks && bx * bx + by * by > best.distance * best.distance * (1.0 + 1e-12)) {
+                k = chunk_end;
+                continue;
+            }
+            for (; k < chunk_end; ++k) {
+                const std::size_t s = cell_ids_[k];
+                Vec2 closest;
+                const double d = point_segment_distance(p, start(s), end(s), &closest);
+                if (d < best.distance || (d == best.distance && s < best.segment)) {
+                    best.distance = d;
+                    best.segment = s;
+                    best.point = closest;
+                }
             }
         }
     }
@@ -197,6 +222,8 @@ class SegmentIndex {
     double h_ = 1.0;
     std::size_t nx_ = 1, ny_ = 1;
     std::vector<std::size_t> cell_start_, cell_ids_;
+    static constexpr std::size_t kChunk = 8;
+    std::vector<Box2> chunk_boxes_;  // entries [kChunk j, kChunk (j + 1)) of cell_ids_
 };
 
 using Nearest = SegmentIndex::Nearest;
