@@ -110,6 +110,7 @@ class Pass {
     Pass(const Scene& work, const RelationSource& relations, const SceneFields& fields,
          const UntangleParams& params, double min_separation, double sample_spacing)
         : fields_(fields),
+          relations_(relations),
           params_(params),
           sample_spacing_(sample_spacing),
           scratch_([&params] { return Scratch(params.composition); }) {
@@ -153,7 +154,10 @@ class Pass {
     }
 
     // The composed value and gradient of `layer` at x (thread-safe with one Scratch per thread).
-    Composed compose_at(std::size_t layer, const Vec2& x, Scratch& s) const {
+    // `flipped`: the layers whose field is taken with its sign changed at x (local sides, see
+    // RelationSource::flipped), or nullptr.
+    Composed compose_at(std::size_t layer, const Vec2& x, Scratch& s,
+                        const std::vector<std::size_t>* flipped = nullptr) const {
         // Only layers whose band box holds x can take part: the others are not sampled.
         s.samples.resize(fields_.size());
         s.f.clear();
@@ -165,7 +169,14 @@ class Pass {
         for (std::size_t j = 0; j < s.samples.size(); ++j) {
             if (j == layer || !band_boxes_[j].contains(x)) continue;
             s.samples[j] = fields_.field(j).sample_in_band(x);
-            if (s.samples[j].in_band && s.samples[j].border > 0.0) s.members.push_back(j);
+            if (!(s.samples[j].in_band && s.samples[j].border > 0.0)) continue;
+            s.members.push_back(j);
+            if (flipped && std::find(flipped->begin(), flipped->end(), j) != flipped->end()) {
+                // x keeps the other side of j than the global order's: the composition sees
+                // it there, and pushes it away from j on that side.
+                s.samples[j].value = -s.samples[j].value;
+                s.samples[j].gradient = -s.samples[j].gradient;
+            }
         }
         Composed out;
         out.f = s.samples[layer].value;
@@ -320,7 +331,9 @@ class Pass {
                     const std::size_t k = index - offset[p];
                     if (is_vertex) {
                         if (piece.is_free[k]) {
-                            const Composed c = compose_at(piece.layer, x[piece.vertices[k]], s);
+                            const Composed c =
+                                compose_at(piece.layer, x[piece.vertices[k]], s,
+                                           relations_.flipped_at(piece.layer, piece.vertices[k]));
                             violation_[i] = std::abs(c.fhat - c.f);
                             own_[i] = step_toward_zero(c);
                         }
@@ -330,8 +343,14 @@ class Pass {
                     if (!piece.is_free[k] && !piece.is_free[k2]) continue;
                     const Vec2 a = x[piece.vertices[k]], b = x[piece.vertices[k2]];
                     edge_samples(scene, piece.layer, a, b, s.ts);
+                    const std::vector<std::size_t>* flipped_a =
+                        relations_.flipped_at(piece.layer, piece.vertices[k]);
+                    const std::vector<std::size_t>* flipped_b =
+                        relations_.flipped_at(piece.layer, piece.vertices[k2]);
                     for (double t : s.ts) {
-                        const Composed c = compose_at(piece.layer, a + t * (b - a), s);
+                        // An edge's points take the local sides of its nearer end.
+                        const Composed c = compose_at(piece.layer, a + t * (b - a), s,
+                                                      t < 0.5 ? flipped_a : flipped_b);
                         if (!c.is_violated) continue;
                         violation_[i] = std::max(violation_[i], std::abs(c.fhat - c.f));
                         const Vec2 d = step_toward_zero(c);
@@ -428,6 +447,7 @@ class Pass {
 
   private:
     const SceneFields& fields_;
+    const RelationSource& relations_;
     const UntangleParams& params_;
     double sample_spacing_ = 0.0;
     double reach_ = 0.0;  // how far from an edge a vertex of another layer gets its own sample

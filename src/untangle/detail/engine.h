@@ -24,6 +24,27 @@ struct RelationSource {
         return of(a) == of(b) ? 0.0 : scene->required_separation(of(a), of(b));
     }
     double weight(std::size_t a) const { return scene->layer(of(a)).weight; }
+
+    /// Local sides (strata/geometry/input_sides.h): flipped[i][k] lists the work layers j
+    /// (open) whose side vertex k of work layer i keeps opposite to the one the global order
+    /// asks for, as the input has it (a rolled or folded-over part). There the composition
+    /// takes f_j with its sign changed, and the finishing stage wants the other side of j.
+    /// Empty (or an empty entry): the global order.
+    std::vector<std::vector<std::vector<std::size_t>>> flipped;
+
+    /// Whether vertex k of work layer i keeps the side of work layer j opposite to the
+    /// global order (see `flipped`).
+    bool is_flipped(std::size_t i, std::size_t k, std::size_t j) const {
+        if (i >= flipped.size() || k >= flipped[i].size()) return false;
+        for (std::size_t x : flipped[i][k])
+            if (x == j) return true;
+        return false;
+    }
+    /// The flipped layers of vertex k of work layer i, or nullptr when none.
+    const std::vector<std::size_t>* flipped_at(std::size_t i, std::size_t k) const {
+        if (i >= flipped.size() || k >= flipped[i].size() || flipped[i][k].empty()) return nullptr;
+        return &flipped[i][k];
+    }
 };
 
 /// Scene-wide settings of the engine, resolved once.
