@@ -813,9 +813,14 @@ InputSides record_input_sides(const Scene& scene, const InputSideParams& params)
         const std::vector<Vec2>& points = scene.layer(a).points;
         std::vector<signed char>& sides = out.sides_[a * n + b];
         sides.assign(points.size(), 0);
-        for (std::size_t k = 0; k < points.size(); ++k)
-            sides[k] = static_cast<signed char>(
-                side_of(indices[b], points[k], nearest_on(indices[b], points[k], reach)));
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const Nearest nr = nearest_on(indices[b], points[k], reach);
+            const int side = side_of(indices[b], points[k], nr);
+            // Found, not on b, and no side: closest to an end point of b.
+            sides[k] = side == 0 && nr.found() && nr.distance > 0.0
+                           ? InputSides::kBeyondEnd
+                           : static_cast<signed char>(side);
+        }
     });
     return out;
 }

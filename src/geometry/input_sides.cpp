@@ -50,7 +50,7 @@ std::size_t InputSides::rolled_count(const Scene& scene,
             if (a == b) continue;
             const int wanted = global_side(scene.relation(a, b), outside_sides[b]);
             for (signed char s : sides_[a * n_ + b])
-                if (s != 0 && s != wanted) ++count;
+                if (s != 0 && s != kBeyondEnd && s != wanted) ++count;
         }
     return count;
 }

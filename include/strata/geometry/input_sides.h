@@ -40,9 +40,13 @@ class InputSides {
     bool empty() const { return n_ == 0; }
     /// See the class comment; 0 for indices out of range.
     int side(std::size_t a, std::size_t k, std::size_t b) const {
-        if (a >= n_ || b >= n_) return 0;
-        const std::vector<signed char>& s = sides_[a * n_ + b];
-        return k < s.size() ? s[k] : 0;
+        const int s = code(a, k, b);
+        return s == kBeyondEnd ? 0 : s;
+    }
+    /// Vertex k of layer a is within the reach of open layer b but closest to one of its end
+    /// points (around the end of b, e.g. on the bend of a roll): it has no side of b.
+    bool beyond_end(std::size_t a, std::size_t k, std::size_t b) const {
+        return code(a, k, b) == kBeyondEnd;
     }
     /// The same sides for a scene with the same layers whose vertex k of layer a is vertex
     /// origin[a][k] of the recorded one (a simplification keeps vertices and their order).
@@ -53,6 +57,12 @@ class InputSides {
     std::size_t rolled_count(const Scene& scene, const std::vector<int>& outside_sides) const;
 
   private:
+    static constexpr signed char kBeyondEnd = 2;
+    int code(std::size_t a, std::size_t k, std::size_t b) const {
+        if (a >= n_ || b >= n_) return 0;
+        const std::vector<signed char>& s = sides_[a * n_ + b];
+        return k < s.size() ? s[k] : 0;
+    }
     friend InputSides record_input_sides(const Scene&, const InputSideParams&);
     std::size_t n_ = 0;
     std::vector<std::vector<signed char>> sides_;  // [a * n + b][k]

@@ -174,7 +174,7 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
         job.settings.outside_signs.push_back(settings_.outside_signs[run.layer]);
     }
     job.work.emplace(std::move(work_layers));
-    flip_rolled(job);
+    local_sides(job);
     job.moving.clear();
     for (const Run& run : job.runs) {
         const WorkLayer& o = live_.layer(run.layer);
@@ -187,10 +187,11 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
     return Prepared::Ready;
 }
 
-// The local sides of the job's vertices (RelationSource::flipped): a vertex whose input side
-// of an open layer under or over its own is not the global order's keeps it in the job's
-// untangling. Nothing is set when no vertex of the job is rolled.
-void JobRunner::flip_rolled(Job& job) const {
+// The local sides of the job's vertices (RelationSource::local_sides): a vertex whose input
+// side of an open layer under or over its own is not the global order's keeps it in the job's
+// untangling, and one around an end of that layer keeps its distance on any side. Nothing is
+// set when the job has no such vertex.
+void JobRunner::local_sides(Job& job) const {
     if (sides_.empty()) return;
     const std::size_t runs = job.runs.size();
     for (std::size_t r = 0; r < runs; ++r) {
@@ -202,12 +203,18 @@ void JobRunner::flip_rolled(Job& job) const {
                 global_side(input_.relation(run.layer, other), settings_.outside_signs[other]);
             if (wanted == 0) continue;
             for (std::size_t k = 0; k < run.ids.size(); ++k) {
-                const int side = sides_.side(run.layer, run.ids[k], other);
-                if (side == 0 || side == wanted) continue;
-                if (job.relations.flipped.empty()) job.relations.flipped.resize(runs);
-                if (job.relations.flipped[r].empty())
-                    job.relations.flipped[r].resize(run.ids.size());
-                job.relations.flipped[r][k].push_back(r2);
+                const std::size_t id = run.ids[k];
+                const int side = sides_.side(run.layer, id, other);
+                RelationSource::Side how = RelationSource::Side::Global;
+                if (sides_.beyond_end(run.layer, id, other))
+                    how = RelationSource::Side::AnySide;
+                else if (side != 0 && side != wanted)
+                    how = RelationSource::Side::Flipped;
+                if (how == RelationSource::Side::Global) continue;
+                auto& all = job.relations.local_sides;
+                if (all.empty()) all.resize(runs);
+                if (all[r].empty()) all[r].resize(run.ids.size());
+                all[r][k].push_back({r2, how});
             }
         }
     }

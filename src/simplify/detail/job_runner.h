@@ -43,7 +43,7 @@ class JobRunner {
     void apply(const Job& job);
 
   private:
-    void flip_rolled(Job& job) const;
+    void local_sides(Job& job) const;
     void mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked,
               const std::vector<Job>& waiting);
     bool is_marked(std::size_t k, std::size_t v) const {

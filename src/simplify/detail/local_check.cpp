@@ -218,20 +218,28 @@ int LocalCheck::side_against(std::size_t k, const Vec2& p, const Overlay& ov) co
     double best = reach_;
     std::size_t seg = kNone;
     Vec2 closest{0.0};
-    ov.near(box.inflated(reach_), [&](std::size_t j, std::size_t u) {
-        if (j != k) return;
-        const Vec2 a = ov.pos(k, u), b = ov.pos(k, w.next[u]);
-        if (a == b) return;  // zero length: its point is an end of its neighbours
-        Vec2 c;
-        const double d = point_segment_distance(p, a, b, &c);
-        // check_scene(): the segment of smallest index among equally close ones (input ids
-        // run in layer order on an open layer).
-        if (d < best || (d == best && seg != kNone && u < seg)) {
-            best = d;
-            seg = u;
-            closest = c;
-        }
-    });
+    // Boxes growing from the largest separation to reach_: every segment closer than r meets
+    // the box inflated by r, so a closest one found within r is the closest.
+    for (double r = std::min(reach_, std::max(separations_.max_reach, 1e-3 * reach_));;
+         r = std::min(reach_, 2.0 * r)) {
+        best = reach_;
+        seg = kNone;
+        ov.near(box.inflated(r), [&](std::size_t j, std::size_t u) {
+            if (j != k) return;
+            const Vec2 a = ov.pos(k, u), b = ov.pos(k, w.next[u]);
+            if (a == b) return;  // zero length: its point is an end of its neighbours
+            Vec2 c;
+            const double d = point_segment_distance(p, a, b, &c);
+            // check_scene(): the segment of smallest index among equally close ones (input
+            // ids run in layer order on an open layer).
+            if (d < best || (d == best && seg != kNone && u < seg)) {
+                best = d;
+                seg = u;
+                closest = c;
+            }
+        });
+        if ((seg != kNone && best <= r) || r >= reach_) break;
+    }
     if (seg == kNone || best == 0.0) return 0;
     const std::size_t e = w.next[seg];
     const Vec2 a = ov.pos(k, seg), b = ov.pos(k, e);

@@ -25,25 +25,35 @@ struct RelationSource {
     }
     double weight(std::size_t a) const { return scene->layer(of(a)).weight; }
 
-    /// Local sides (strata/geometry/input_sides.h): flipped[i][k] lists the work layers j
-    /// (open) whose side vertex k of work layer i keeps opposite to the one the global order
-    /// asks for, as the input has it (a rolled or folded-over part). There the composition
-    /// takes f_j with its sign changed, and the finishing stage wants the other side of j.
+    /// How a vertex takes the field of another layer (local sides, input_sides.h).
+    enum class Side : unsigned char {
+        Global,   ///< As the global order says.
+        Flipped,  ///< On the other side: f_j with its sign changed (a rolled part).
+        AnySide,  ///< Around an end of open layer j: only the distance counts.
+    };
+    struct LocalSide {
+        std::size_t layer = 0;  ///< The other work layer j (open).
+        Side side = Side::Global;
+    };
+    /// local_sides[i][k]: the work layers whose field vertex k of work layer i takes otherwise
+    /// than the global order says, as the input has it. There the composition takes f_j with
+    /// its sign changed (Flipped) or with the sign the nesting wants (AnySide: |f_j| kept),
+    /// and the finishing stage wants the other side (Flipped) or any side (AnySide).
     /// Empty (or an empty entry): the global order.
-    std::vector<std::vector<std::vector<std::size_t>>> flipped;
+    std::vector<std::vector<std::vector<LocalSide>>> local_sides;
 
-    /// Whether vertex k of work layer i keeps the side of work layer j opposite to the
-    /// global order (see `flipped`).
-    bool is_flipped(std::size_t i, std::size_t k, std::size_t j) const {
-        if (i >= flipped.size() || k >= flipped[i].size()) return false;
-        for (std::size_t x : flipped[i][k])
-            if (x == j) return true;
-        return false;
+    /// The local sides of vertex k of work layer i, or nullptr when none.
+    const std::vector<LocalSide>* local_at(std::size_t i, std::size_t k) const {
+        if (i >= local_sides.size() || k >= local_sides[i].size() || local_sides[i][k].empty())
+            return nullptr;
+        return &local_sides[i][k];
     }
-    /// The flipped layers of vertex k of work layer i, or nullptr when none.
-    const std::vector<std::size_t>* flipped_at(std::size_t i, std::size_t k) const {
-        if (i >= flipped.size() || k >= flipped[i].size() || flipped[i][k].empty()) return nullptr;
-        return &flipped[i][k];
+    /// How vertex k of work layer i takes work layer j.
+    Side side_of(std::size_t i, std::size_t k, std::size_t j) const {
+        if (const std::vector<LocalSide>* all = local_at(i, k))
+            for (const LocalSide& x : *all)
+                if (x.layer == j) return x.side;
+        return Side::Global;
     }
 };
 

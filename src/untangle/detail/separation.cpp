@@ -347,7 +347,7 @@ class Finisher {
     // The side of layer m's segments (orient2d sign) that layer l's vertices must be on, by
     // the nesting: inside m when l is under m, outside when over; 0 when any side will do
     // (side-by-side layers push apart whatever the side). Vertex v keeps the other side where
-    // the input has it there (RelationSource::flipped: a rolled part).
+    // the input has it there, or any side around an end of m (RelationSource::local_sides).
     int wanted_side(std::size_t l, std::size_t v, std::size_t m) const {
         const Relation r = relation_[l * pts_.size() + m];
         if (r == Relation::SideBySide || params_.outside_signs == nullptr ||
@@ -355,7 +355,14 @@ class Finisher {
             return 0;
         const int outside = (*params_.outside_signs)[m];  // +1: outside on the right
         const int wanted = r == Relation::Under ? outside : -outside;
-        return relations_.is_flipped(l, v, m) ? -wanted : wanted;
+        switch (relations_.side_of(l, v, m)) {
+            case RelationSource::Side::Flipped:
+                return -wanted;
+            case RelationSource::Side::AnySide:
+                return 0;
+            default:
+                return wanted;
+        }
     }
 
     // Moves vertex (l, v) by `delta`, or by a half, a quarter or an eighth of it when the full

@@ -1,0 +1,145 @@
+// Rolled layers (issue 19): an inner layer that comes around the end of the outer one and lies
+// on top of it. The input's own sides are the order to keep there (input_sides.h).
+#include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
+#include "strata/simplify/scene_families.h"
+#include "strata/simplify/simplify.h"
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+using namespace strata;
+
+namespace {
+
+std::vector<int> outside_sides(const Scene& scene) {
+    std::vector<int> sides;
+    for (std::size_t l = 0; l < scene.size(); ++l) sides.push_back(outside_side(scene, l));
+    return sides;
+}
+
+std::vector<std::vector<std::size_t>> identity(const Scene& scene) {
+    std::vector<std::vector<std::size_t>> ids;
+    for (const Layer& layer : scene.layers()) {
+        ids.emplace_back(layer.points.size());
+        std::iota(ids.back().begin(), ids.back().end(), std::size_t{0});
+    }
+    return ids;
+}
+
+// Gap between the layers of a rolled scene, scene units (scene_families.cpp).
+double rolled_gap(const FamilyParams& p) {
+    return p.gap * 10.0 / static_cast<double>(p.points - 1);
+}
+
+}  // namespace
+
+TEST_CASE("the input's sides record the roll; a vertex that changes side is flagged", "[rolled]") {
+    for (double gap : {1.0, 2.0, 4.0}) {
+        INFO("gap " << gap);
+        FamilyParams params;
+        params.points = 300;
+        params.gap = gap;
+        const Scene scene = make_scene(SceneFamily::Rolled, params);
+        const InputSides sides = record_input_sides(scene);
+        const std::vector<int> outside = outside_sides(scene);
+        // Inner (0) under outer (1); the roll's top part lies over the outer layer.
+        CHECK(sides.rolled_count(scene, outside) > 0);
+
+        CheckParams cp;
+        cp.outside_sides = outside;
+        const InputSides own = sides.renumbered(identity(scene));
+        cp.input_sides = &own;
+        const CheckReport against_itself = check_scene(scene, cp);
+        CHECK(against_itself.crossing_count == 0);
+        CHECK(against_itself.nesting_violation_count == 0);
+
+        // The roll's top part moved under the inner's own base: those vertices left the side
+        // of the outer layer the input gives them (the segments joining them to the roll's
+        // arc cross too; what is checked here is the nesting).
+        std::vector<Layer> layers = scene.layers();
+        const double g = rolled_gap(params);
+        std::size_t moved = 0;
+        for (Vec2& p : layers[0].points)
+            if (p.y > 2.5 * g && p.x < 8.0) {
+                p.y = -2.0 * g;  // under the inner's own base: the order of the input is lost
+                ++moved;
+            }
+        REQUIRE(moved > 0);
+        const Scene flipped(layers);
+        const CheckReport changed = check_scene(flipped, cp);
+        CHECK(changed.nesting_violation_count > 0);
+    }
+}
+
+TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolled]") {
+    const char* const decimators[] = {"random", "visvalingam", "max-error"};
+    for (double gap : {2.0, 4.0}) {
+        FamilyParams fp;
+        fp.points = 600;
+        fp.gap = gap;
+        const Scene input = make_scene(SceneFamily::Rolled, fp);
+        const double g = rolled_gap(fp);
+        const std::vector<int> outside = outside_sides(input);
+        const InputSides sides = record_input_sides(input);
+        REQUIRE(sides.rolled_count(input, outside) > 0);
+        for (const char* decimator : decimators)
+            for (double remove : {0.9, 0.95})
+                for (UntangleSchedule schedule :
+                     {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                    INFO("gap " << gap << " " << decimator << " remove " << remove
+                                << (schedule == UntangleSchedule::Deferred ? " deferred"
+                                                                           : " immediate"));
+                    SimplifyParams params;
+                    params.decimator = decimator;
+                    params.remove = remove;
+                    params.schedule = schedule;
+                    Scene out = input;
+                    const SimplifyReport report = simplify(out, params);
+                    CHECK(report.collision_free);
+                    // The rolled layer meets its budget. (The outer one is a straight line:
+                    // its collinear removals are refused the same way without the roll, a
+                    // weakness of the driver's local test, not of the sides.)
+                    // Budget and shape below: asked of the error-driven decimators with the
+                    // default, deferred schedule. The immediate schedule stays clean but
+                    // refuses most removals of the rolled layer (measured at 600 points, gap
+                    // 2: 577 vertices left for a target of 79, Hausdorff 0.12 to 0.34).
+                    const bool shape_asked = std::string(decimator) != "random" &&
+                                             schedule == UntangleSchedule::Deferred;
+                    if (shape_asked) CHECK(report.layers[0].after <= report.layers[0].target);
+                    CHECK(report.rolled_vertices > 0);
+
+                    // Checked here again, independently of simplify()'s own check.
+                    CheckParams cp;
+                    cp.outside_sides = outside;
+                    cp.separation_tolerance = params.untangling.separation_tolerance;
+                    const InputSides out_sides = sides.renumbered(report.origins);
+                    cp.input_sides = &out_sides;
+                    const CheckReport check = check_scene(out, cp);
+                    CHECK(check.crossing_count == 0);
+                    CHECK(check.total_self_crossings() == 0);
+                    CHECK(check.nesting_violation_count == 0);
+                    CHECK(check.separation_violation_count == 0);
+                    CHECK(check.min_separation_ratio >= 0.9);
+                    // The shape: within 2 gaps of the input. Not asked of the random
+                    // decimator, which may remove the whole bend of the roll and leave the
+                    // untangling to pull the layer around the end of the other one (measured:
+                    // Hausdorff 0.75 = 22 gaps on gap 2, clean; README, what is missing).
+                    if (shape_asked)
+                        for (std::size_t l = 0; l < out.size(); ++l)
+                            CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * g).symmetric() <=
+                                  2.0 * g);
+                    // The roll is kept: the top of the roll (input y = 3 gaps, over the outer
+                    // layer at y = gap) stays over the outer layer.
+                    const Layer& inner = out.layer(0);
+                    for (std::size_t k = 0; k < inner.points.size(); ++k) {
+                        const Vec2 was = input.layer(0).points[report.origins[0][k]];
+                        if (was.y > 2.5 * g && was.x < 8.0) CHECK(inner.points[k].y > 1.5 * g);
+                    }
+                }
+    }
+}
