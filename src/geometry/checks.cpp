@@ -19,6 +19,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -822,6 +823,44 @@ InputSides record_input_sides(const Scene& scene, const InputSideParams& params)
                            : static_cast<signed char>(side);
         }
     });
+    return out;
+}
+
+InputSides InputSides::matched(const InputSides& recorded, const Scene& reference,
+                               const Scene& scene) {
+    InputSides out;
+    if (recorded.empty()) return out;
+    const std::size_t n = scene.size();
+    out.n_ = n;
+    out.sides_.assign(n * n, {});
+    std::vector<std::optional<std::size_t>> namesake(n);
+    for (std::size_t i = 0; i < n; ++i) namesake[i] = reference.find(scene.layer(i).name);
+    for (std::size_t a = 0; a < n; ++a) {
+        if (!namesake[a] || *namesake[a] >= recorded.n_) continue;
+        const std::size_t ra = *namesake[a];
+        const Layer& ref_layer = reference.layer(ra);
+        const SegmentIndex index(ref_layer);
+        // The reference vertex of each vertex of layer a: the nearer end of its closest segment.
+        std::vector<std::size_t> origin;
+        for (const Vec2& p : scene.layer(a).points) {
+            const Nearest nr = nearest_on(index, p);
+            std::size_t k = 0;
+            if (nr.found()) {
+                const Vec2 s0 = index.start(nr.segment), s1 = index.end(nr.segment);
+                const bool first = std::hypot(nr.point.x - s0.x, nr.point.y - s0.y) <=
+                                   std::hypot(nr.point.x - s1.x, nr.point.y - s1.y);
+                k = first ? nr.segment : (nr.segment + 1) % ref_layer.points.size();
+            }
+            origin.push_back(k);
+        }
+        for (std::size_t b = 0; b < n; ++b) {
+            if (!namesake[b] || *namesake[b] >= recorded.n_) continue;
+            const std::vector<signed char>& from = recorded.sides_[ra * recorded.n_ + *namesake[b]];
+            if (from.empty()) continue;
+            std::vector<signed char>& to = out.sides_[a * n + b];
+            for (std::size_t k : origin) to.push_back(k < from.size() ? from[k] : 0);
+        }
+    }
     return out;
 }
 

@@ -143,3 +143,45 @@ TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolle
                 }
     }
 }
+
+TEST_CASE("sides matched by nearest vertex (strata check --reference) judge a simplified roll",
+          "[rolled]") {
+    FamilyParams fp;
+    fp.points = 400;
+    fp.gap = 2.0;
+    const Scene input = make_scene(SceneFamily::Rolled, fp);
+    const double g = rolled_gap(fp);
+    const InputSides recorded = record_input_sides(input);
+    SimplifyParams params;
+    params.remove = 0.9;
+    Scene out = input;
+    const SimplifyReport report = simplify(out, params);
+    REQUIRE(report.collision_free);
+
+    CheckParams cp;
+    cp.outside_sides = outside_sides(input);
+    cp.separation_tolerance = params.untangling.separation_tolerance;
+    // Without the vertex correspondence, as the CLI has it: the same verdict as simplify()'s.
+    const InputSides matched = InputSides::matched(recorded, input, out);
+    cp.input_sides = &matched;
+    CHECK(check_scene(out, cp).nesting_violation_count == 0);
+    // The global order alone calls the roll wrong.
+    cp.input_sides = nullptr;
+    CHECK(check_scene(out, cp).nesting_violation_count > 0);
+
+    // The roll's top pushed under the outer layer, between the two layers (crossing it): the
+    // outer layer's vertices there now lie on the other side of the inner layer's nearest
+    // part than in the reference, which the matched sides find.
+    std::vector<Layer> layers = out.layers();
+    std::size_t moved = 0;
+    for (Vec2& p : layers[0].points)
+        if (p.y > 2.5 * g && p.x < 7.5 && p.x > 5.5) {
+            p.y = 0.5 * g;
+            ++moved;
+        }
+    REQUIRE(moved > 0);
+    const Scene pushed(layers);
+    const InputSides matched_pushed = InputSides::matched(recorded, input, pushed);
+    cp.input_sides = &matched_pushed;
+    CHECK(check_scene(pushed, cp).nesting_violation_count > 0);
+}

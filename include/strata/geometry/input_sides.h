@@ -52,6 +52,13 @@ class InputSides {
     /// origin[a][k] of the recorded one (a simplification keeps vertices and their order).
     /// @throws InvalidInput when origin has the wrong layer count or an index out of range.
     InputSides renumbered(const std::vector<std::vector<std::size_t>>& origin) const;
+    /// The sides for `scene`, whose layers are those of `reference` (the scene these sides were
+    /// recorded in) matched by name, when the vertex correspondence is not known (`strata
+    /// check --reference`): each vertex takes the sides of the reference vertex that ends the
+    /// closest segment of its layer's reference nearest to it. Layers without a namesake get
+    /// none. Defined in checks.cpp (nearest queries).
+    static InputSides matched(const InputSides& recorded, const Scene& reference,
+                              const Scene& scene);
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
     /// outside_side() per layer): the rolled or folded-over vertices, once per other layer.
     std::size_t rolled_count(const Scene& scene, const std::vector<int>& outside_sides) const;
