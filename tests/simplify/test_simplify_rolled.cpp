@@ -6,6 +6,7 @@
 #include "strata/simplify/simplify.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -140,6 +141,71 @@ TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolle
                         const Vec2 was = input.layer(0).points[report.origins[0][k]];
                         if (was.y > 2.5 * g && was.x < 8.0) CHECK(inner.points[k].y > 1.5 * g);
                     }
+                }
+    }
+}
+
+namespace {
+
+// A rolled scene with waves (the generated family's layers are straight lines, whose collinear
+// removals the driver refuses with or without a roll): inner base y = w(x) on [0, 9], a half
+// circle of radius 1.5 gaps around x = 9, the top back to x = 5 at 3 gaps; the outer layer at
+// 1 gap over [0, 8]; w(x) = 0.3 gap sin 2x. Thickness half the gap (required: half the gap).
+Scene wavy_roll(std::size_t points, double gap_in_segments) {
+    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
+    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
+    Layer inner, outer;
+    inner.name = "inner";
+    outer.name = "outer";
+    inner.thickness = outer.thickness = 0.5 * g;
+    for (double x = 0.0; x <= 8.0 + 1e-9; x += s) outer.points.emplace_back(x, g + w(x));
+    for (double x = 0.0; x < 9.0; x += s) inner.points.emplace_back(x, w(x));
+    const double r = 1.5 * g, pi = 3.14159265358979323846;
+    const int steps = std::max(4, static_cast<int>(std::ceil(pi * r / s)));
+    for (int j = 1; j < steps; ++j) {
+        const double a = -0.5 * pi + pi * j / steps;
+        inner.points.emplace_back(9.0 + r * std::cos(a), r + r * std::sin(a) + w(9.0));
+    }
+    for (double x = 9.0; x >= 5.0; x -= s) inner.points.emplace_back(x, 3.0 * g + w(x));
+    return Scene({inner, outer});
+}
+
+}  // namespace
+
+TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
+    for (double gap : {2.0, 4.0}) {
+        const Scene input = wavy_roll(600, gap);
+        const double g = gap * 10.0 / 599.0;
+        const std::vector<int> outside = outside_sides(input);
+        const InputSides sides = record_input_sides(input);
+        REQUIRE(sides.rolled_count(input, outside) > 0);
+        for (const char* decimator : {"visvalingam", "max-error"})
+            for (double remove : {0.9, 0.95})
+                for (UntangleSchedule schedule :
+                     {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                    INFO("gap " << gap << " " << decimator << " remove " << remove
+                                << (schedule == UntangleSchedule::Deferred ? " deferred"
+                                                                           : " immediate"));
+                    SimplifyParams params;
+                    params.decimator = decimator;
+                    params.remove = remove;
+                    params.schedule = schedule;
+                    Scene out = input;
+                    const SimplifyReport report = simplify(out, params);
+                    CHECK(report.collision_free);
+                    CHECK(report.targets_met);
+                    CheckParams cp;
+                    cp.outside_sides = outside;
+                    cp.separation_tolerance = params.untangling.separation_tolerance;
+                    const InputSides out_sides = sides.renumbered(report.origins);
+                    cp.input_sides = &out_sides;
+                    const CheckReport check = check_scene(out, cp);
+                    CHECK(check.crossing_count == 0);
+                    CHECK(check.nesting_violation_count == 0);
+                    CHECK(check.min_separation_ratio >= 0.9);
+                    for (std::size_t l = 0; l < out.size(); ++l)
+                        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * g).symmetric() <=
+                              2.0 * g);
                 }
     }
 }
