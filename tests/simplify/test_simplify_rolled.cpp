@@ -210,6 +210,130 @@ TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
     }
 }
 
+namespace {
+
+// Both layers rolled together, around a centre at (9, 1.5 gaps): the inner layer (base y = 0)
+// takes the outside of the bend (radius 1.5 gaps), the outer one (base y = 1 gap) its inside
+// (radius 0.5 gap); back on top, the inner layer lies over the outer one: the order flips.
+// Same waves as wavy_roll().
+Scene both_rolled(std::size_t points, double gap_in_segments) {
+    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
+    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
+    const double pi = 3.14159265358979323846;
+    Layer inner, outer;
+    inner.name = "inner";
+    outer.name = "outer";
+    inner.thickness = outer.thickness = 0.25 * g;  // required: half a gap, as on the bend
+    auto roll = [&](Layer& layer, double base, double radius) {
+        for (double x = 0.0; x < 9.0; x += s) layer.points.emplace_back(x, base + w(x));
+        const int steps = std::max(4, static_cast<int>(std::ceil(pi * radius / s)));
+        for (int j = 1; j < steps; ++j) {
+            const double a = -0.5 * pi + pi * j / steps;
+            layer.points.emplace_back(9.0 + radius * std::cos(a),
+                                      1.5 * g + radius * std::sin(a) + w(9.0));
+        }
+        for (double x = 9.0; x >= 5.0; x -= s) layer.points.emplace_back(x, 3.0 * g - base + w(x));
+    };
+    roll(inner, 0.0, 1.5 * g);
+    roll(outer, g, 0.5 * g);
+    return Scene({inner, outer});
+}
+
+// A shirt rolled over the end of a jacket, both over a closed body: body radius 1 (closed,
+// under the shirt), shirt at 1 + gap over angles [0.5, 5], jacket at 1 + 2 gaps over
+// [0.5, 5 - 4 gaps]; at angle 5 the shirt turns outward around a half circle of radius 1 gap
+// and comes back at 1 + 3 gaps (over the jacket) to angle 4.
+Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments) {
+    const double s = 2.0 * 3.14159265358979323846 / static_cast<double>(points);
+    const double g = gap_in_segments * s, pi = 3.14159265358979323846;
+    auto at = [](double r, double t) { return Vec2(r * std::cos(t), r * std::sin(t)); };
+    Layer body, shirt, jacket;
+    body.name = "body";
+    shirt.name = "shirt";
+    jacket.name = "jacket";
+    body.closed = true;
+    body.thickness = shirt.thickness = jacket.thickness = 0.5 * g;
+    body.outer = std::vector<std::string>{"shirt"};
+    shirt.outer = std::vector<std::string>{"jacket"};
+    jacket.outer = std::vector<std::string>{};
+    for (std::size_t i = 0; i < points; ++i)
+        body.points.push_back(at(1.0, s * static_cast<double>(i)));
+    for (double t = 0.5; t <= 5.0 - 4.0 * g + 1e-12; t += s)
+        jacket.points.push_back(at(1.0 + 2.0 * g, t));
+    for (double t = 0.5; t < 5.0; t += s) shirt.points.push_back(at(1.0 + g, t));
+    const int steps = std::max(4, static_cast<int>(std::ceil(pi * g / s)));
+    const Vec2 centre = at(1.0 + 2.0 * g, 5.0), radial = at(1.0, 5.0),
+               along = at(1.0, 5.0 + 0.5 * pi);
+    for (int j = 0; j <= steps; ++j) {  // from radius 1 + g to 1 + 3 g, bulging forward
+        const double a = pi * j / steps;
+        shirt.points.push_back(centre - g * std::cos(a) * radial + g * std::sin(a) * along);
+    }
+    for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * g, t));
+    return Scene({body, shirt, jacket});
+}
+
+// simplify() on `input` at the given settings: clean, the input's sides kept, gaps >= 0.9 x
+// required, every layer on target, Hausdorff <= 2 x `gap`.
+void check_kept(const Scene& input, double gap, const char* decimator, double remove,
+                UntangleSchedule schedule) {
+    const std::vector<int> outside = outside_sides(input);
+    const InputSides sides = record_input_sides(input);
+    SimplifyParams params;
+    params.decimator = decimator;
+    params.remove = remove;
+    params.schedule = schedule;
+    Scene out = input;
+    const SimplifyReport report = simplify(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.targets_met);
+    CheckParams cp;
+    cp.outside_sides = outside;
+    cp.separation_tolerance = params.untangling.separation_tolerance;
+    const InputSides out_sides = sides.renumbered(report.origins);
+    cp.input_sides = &out_sides;
+    const CheckReport check = check_scene(out, cp);
+    CHECK(check.crossing_count == 0);
+    CHECK(check.total_self_crossings() == 0);
+    CHECK(check.nesting_violation_count == 0);
+    CHECK(check.min_separation_ratio >= 0.9);
+    for (std::size_t l = 0; l < out.size(); ++l)
+        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * gap).symmetric() <= 2.0 * gap);
+}
+
+}  // namespace
+
+TEST_CASE("both layers rolled together, and a shirt rolled over a jacket on a body", "[rolled]") {
+    const Scene together = both_rolled(600, 4.0);
+    const Scene shirt = shirt_rolled_over_jacket(600, 4.0);
+    {
+        const CheckReport in = check_scene(together);
+        REQUIRE(in.crossing_count == 0);
+        REQUIRE(in.total_self_crossings() == 0);
+        const CheckReport in2 = check_scene(shirt);
+        REQUIRE(in2.crossing_count == 0);
+        REQUIRE(in2.total_self_crossings() == 0);
+        // The shirt's top lies over the jacket: the global order is broken there.
+        CHECK(record_input_sides(shirt).rolled_count(shirt, outside_sides(shirt)) > 0);
+    }
+    for (const char* decimator : {"visvalingam", "max-error"})
+        for (double remove : {0.9, 0.95})
+            for (UntangleSchedule schedule :
+                 {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                INFO(decimator << " remove " << remove
+                               << (schedule == UntangleSchedule::Deferred ? " deferred"
+                                                                          : " immediate"));
+                {
+                    INFO("both rolled");
+                    check_kept(together, 4.0 * 10.0 / 599.0, decimator, remove, schedule);
+                }
+                {
+                    INFO("shirt over jacket");
+                    check_kept(shirt, 4.0 * 2.0 * 3.14159265358979323846 / 600.0, decimator, remove,
+                               schedule);
+                }
+            }
+}
+
 TEST_CASE("sides matched by nearest vertex (strata check --reference) judge a simplified roll",
           "[rolled]") {
     FamilyParams fp;
