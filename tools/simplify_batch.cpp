@@ -65,6 +65,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"batch_reruns", r.batch_reruns},
                         {"targets_met", r.targets_met},
                         {"raised_separations", r.raised_separations},
+                        {"rolled_vertices", r.rolled_vertices},
                         {"crossings", r.crossings},
                         {"self_crossings", r.self_crossings},
                         {"nesting_violations", r.nesting_violations},
