@@ -207,6 +207,19 @@ Run add_check_command(CLI::App& app) {
                         : outside_side(scene, i, params.near_distance));
             }
         }
+        // The reference's own sides of its open layers (a rolled part): a nesting violation is
+        // a vertex that left the side its reference has.
+        InputSides reference_sides;
+        std::size_t rolled = 0;
+        if (reference) {
+            const InputSides recorded = record_input_sides(*reference);
+            std::vector<int> reference_outside;
+            for (std::size_t l = 0; l < reference->size(); ++l)
+                reference_outside.push_back(outside_side(*reference, l, params.near_distance));
+            rolled = recorded.rolled_count(*reference, reference_outside);
+            reference_sides = InputSides::matched(recorded, *reference, scene);
+            params.input_sides = &reference_sides;
+        }
         const CheckReport report = check_scene(scene, params);
         std::vector<std::optional<HausdorffDistance>> h;
         if (reference) {
@@ -217,10 +230,20 @@ Run add_check_command(CLI::App& app) {
                              opt->hausdorff_tolerance * std::max(diagonal, 1e-300));
         }
         const bool ok = report.is_collision_free() && (!opt->strict || report.separations_hold());
-        if (opt->json)
-            std::cout << to_json(scene, report, h, ok).dump(2) << '\n';
-        else
+        if (opt->json) {
+            nlohmann::json out = to_json(scene, report, h, ok);
+            // Rolled or folded-over vertices of the reference (their own side kept), if any.
+            if (rolled > 0) out["reference_rolled_vertices"] = rolled;
+            std::cout << out.dump(2) << '\n';
+        } else {
             print_table(opt->input, scene, report, h, ok);
+            if (rolled > 0)
+                std::printf(
+                    "reference: %zu vertices lie on the other side of an open layer than "
+                    "the global order (rolled or folded over); nesting is checked "
+                    "against the reference's sides\n",
+                    rolled);
+        }
         return ok ? 0 : 1;
     };
 }

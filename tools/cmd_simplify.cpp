@@ -61,6 +61,11 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             "gap rule: %zu pairs of layers without thickness keep their share of the "
             "input gap (--keep-gaps)\n",
             r.raised_separations);
+    if (r.rolled_vertices > 0)
+        std::printf(
+            "local sides: %zu input vertices lie on the other side of an open layer than the "
+            "global order (rolled or folded over) and keep it\n",
+            r.rolled_vertices);
     if (!r.collision_free)
         std::fprintf(
             stderr,

@@ -66,6 +66,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"batch_reruns", r.batch_reruns},
                         {"targets_met", r.targets_met},
                         {"raised_separations", r.raised_separations},
+                        {"rolled_vertices", r.rolled_vertices},
                         {"crossings", r.crossings},
                         {"self_crossings", r.self_crossings},
                         {"nesting_violations", r.nesting_violations},
@@ -131,7 +132,13 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
 std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
                                    const SimplifyParams& params,
                                    std::optional<InputUntangling>& untangled) {
-    const CheckReport before = check_scene(input);
+    // The input is its own reference for the sides of open layers (a rolled part lies on the
+    // other side of the global order): only crossings, self-crossings and the nesting of
+    // closed layers can make it tangled.
+    const InputSides own_sides = record_input_sides(input);
+    CheckParams own;
+    own.input_sides = &own_sides;
+    const CheckReport before = check_scene(input, own);
     if (before.is_collision_free()) return input;
     const std::string what = tangle_summary(input, before);
     if (mode == InputCrossings::Skip) return std::nullopt;

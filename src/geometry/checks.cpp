@@ -19,6 +19,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -261,17 +262,8 @@ int side_of(const SegmentIndex& index, const Vec2& v, const Nearest& n) {
         before = s;
         after = index.next(s);
     }
-    if (before == kNone || after == kNone) {
-        const int o = orient2d(a, b, v);
-        return -o;
-    }
-    const Vec2 u = index.start(before), w = index.end(before), x = index.end(after);
-    const int turn = orient2d(u, w, x);
-    const int o1 = orient2d(u, w, v);
-    const int o2 = orient2d(w, x, v);
-    if (turn > 0) return (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
-    if (turn < 0) return (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
-    return o1 != 0 ? -o1 : -o2;
+    if (before == kNone || after == kNone) return segment_side(a, b, v);
+    return corner_side(index.start(before), index.end(before), index.end(after), v);
 }
 
 // side_of() at the closest point within `near`.
@@ -291,14 +283,22 @@ int closed_outside(const Layer& layer) {
     return area < 0.0L ? -1 : 1;
 }
 
+// The reach of record_input_sides() and of the second vote of open_outside(), in near
+// distances: a layer a few gaps off another is within it.
+constexpr double kSideReach = 3.0;
+
 int open_outside(const Scene& scene, std::size_t i, const SegmentIndex& index, double near) {
-    long vote = 0;
-    for (std::size_t j : scene.inner_of(i))
-        for (const Vec2& v : scene.layer(j).points) vote -= side_at(index, v, near);
-    if (vote != 0) return vote > 0 ? 1 : -1;
-    for (std::size_t j : scene.outer_of(i))
-        for (const Vec2& v : scene.layer(j).points) vote += side_at(index, v, near);
-    if (vote != 0) return vote > 0 ? 1 : -1;
+    // Within near; when that gives no vote either way (the neighbours lie at about the near
+    // distance), within kSideReach x near.
+    for (const double reach : {near, kSideReach * near}) {
+        long vote = 0;
+        for (std::size_t j : scene.inner_of(i))
+            for (const Vec2& v : scene.layer(j).points) vote -= side_at(index, v, reach);
+        if (vote != 0) return vote > 0 ? 1 : -1;
+        for (std::size_t j : scene.outer_of(i))
+            for (const Vec2& v : scene.layer(j).points) vote += side_at(index, v, reach);
+        if (vote != 0) return vote > 0 ? 1 : -1;
+    }
     return 1;
 }
 
@@ -572,7 +572,7 @@ class Checker {
                 const Nearest nr = nearest_on(indices_[to], points[k], bound);
                 if (!nr.found()) continue;
                 if (sides && nr.distance < near &&
-                    breaks_nesting(from, to, side_of(indices_[to], points[k], nr)))
+                    breaks_nesting(from, k, to, side_of(indices_[to], points[k], nr)))
                     wrong_side_[from * n_ + to].push_back(k);
                 if (nr.distance < pair.gap) {
                     pair.gap = nr.distance;
@@ -623,10 +623,14 @@ class Checker {
                bounds_[a].overlaps(bounds_[b].inflated(report_.near_distance));
     }
 
-    // A vertex of layer a on `side` (side_of()) of open layer b breaks their nesting.
-    bool breaks_nesting(std::size_t a, std::size_t b, int side) const {
-        const Relation rel = scene_.relation(a, b);
-        return side != 0 && (rel == Relation::Under ? side == outside_[b] : side == -outside_[b]);
+    // Vertex k of layer a on `side` (side_of()) of open layer b breaks their nesting: the
+    // side is not the one recorded in the input (params.input_sides), or, where nothing is
+    // recorded, not the one the global order asks for.
+    bool breaks_nesting(std::size_t a, std::size_t k, std::size_t b, int side) const {
+        if (side == 0) return false;
+        int wanted = params_.input_sides ? params_.input_sides->side(a, k, b) : 0;
+        if (wanted == 0) wanted = global_side(scene_.relation(a, b), outside_[b]);
+        return wanted != 0 && side != wanted;
     }
 
     // Ordered pairs in parallel, reported in (a, b) order.
@@ -667,7 +671,7 @@ class Checker {
                                                 : where == Placement::Inside;
             } else {
                 broken =
-                    breaks_nesting(a, b, side_at(indices_[b], points[k], report_.near_distance));
+                    breaks_nesting(a, k, b, side_at(indices_[b], points[k], report_.near_distance));
             }
             if (broken) out.push_back(k);
         }
@@ -808,6 +812,83 @@ CheckReport check_scene(const Scene& scene, const CheckParams& params) {
                                scene.layer(i).name + "') must be +1 or -1 (got " +
                                std::to_string(params.outside_sides[i]) + ")");
     return Checker(scene, params).run();
+}
+
+// Defined here, next to the nearest queries and the side rule that check_scene() uses, so
+// that the recorded sides and the checked ones are decided by the same code.
+InputSides record_input_sides(const Scene& scene, const InputSideParams& params) {
+    validate(params);
+    const double reach = params.reach > 0.0 ? params.reach : kSideReach * automatic_near(scene);
+    const std::size_t n = scene.size();
+    InputSides out;
+    out.n_ = n;
+    out.sides_.assign(n * n, {});
+    std::vector<SegmentIndex> indices(n);
+    std::vector<Box2> bounds;
+    for (std::size_t i = 0; i < n; ++i) bounds.push_back(scene.layer(i).bounds());
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t b) {
+        if (!scene.layer(b).closed) indices[b] = SegmentIndex(scene.layer(b));
+    });
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = 0; b < n; ++b) {
+            const Relation r = a == b ? Relation::Same : scene.relation(a, b);
+            if (scene.layer(b).closed || (r != Relation::Under && r != Relation::Over)) continue;
+            if (bounds[a].overlaps(bounds[b].inflated(reach))) pairs.emplace_back(a, b);
+        }
+    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t t) {
+        const auto [a, b] = pairs[t];
+        const std::vector<Vec2>& points = scene.layer(a).points;
+        std::vector<signed char>& sides = out.sides_[a * n + b];
+        sides.assign(points.size(), 0);
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const Nearest nr = nearest_on(indices[b], points[k], reach);
+            const int side = side_of(indices[b], points[k], nr);
+            // Found, not on b, and no side: closest to an end point of b.
+            sides[k] = side == 0 && nr.found() && nr.distance > 0.0
+                           ? InputSides::kBeyondEnd
+                           : static_cast<signed char>(side);
+        }
+    });
+    return out;
+}
+
+InputSides InputSides::matched(const InputSides& recorded, const Scene& reference,
+                               const Scene& scene) {
+    InputSides out;
+    if (recorded.empty()) return out;
+    const std::size_t n = scene.size();
+    out.n_ = n;
+    out.sides_.assign(n * n, {});
+    std::vector<std::optional<std::size_t>> namesake(n);
+    for (std::size_t i = 0; i < n; ++i) namesake[i] = reference.find(scene.layer(i).name);
+    for (std::size_t a = 0; a < n; ++a) {
+        if (!namesake[a] || *namesake[a] >= recorded.n_) continue;
+        const std::size_t ra = *namesake[a];
+        const Layer& ref_layer = reference.layer(ra);
+        const SegmentIndex index(ref_layer);
+        // The reference vertex of each vertex of layer a: the nearer end of its closest segment.
+        std::vector<std::size_t> origin;
+        for (const Vec2& p : scene.layer(a).points) {
+            const Nearest nr = nearest_on(index, p);
+            std::size_t k = 0;
+            if (nr.found()) {
+                const Vec2 s0 = index.start(nr.segment), s1 = index.end(nr.segment);
+                const bool first = std::hypot(nr.point.x - s0.x, nr.point.y - s0.y) <=
+                                   std::hypot(nr.point.x - s1.x, nr.point.y - s1.y);
+                k = first ? nr.segment : (nr.segment + 1) % ref_layer.points.size();
+            }
+            origin.push_back(k);
+        }
+        for (std::size_t b = 0; b < n; ++b) {
+            if (!namesake[b] || *namesake[b] >= recorded.n_) continue;
+            const std::vector<signed char>& from = recorded.sides_[ra * recorded.n_ + *namesake[b]];
+            if (from.empty()) continue;
+            std::vector<signed char>& to = out.sides_[a * n + b];
+            for (std::size_t k : origin) to.push_back(k < from.size() ? from[k] : 0);
+        }
+    }
+    return out;
 }
 
 int outside_side(const Scene& scene, std::size_t i, double near_distance) {

@@ -93,8 +93,18 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     detail::LivePolylines live(input, targets_of(input, params));
     const detail::Separations separations =
         detail::separations_of(input, params.untangling.separation_tolerance);
-    const detail::LocalCheck check(input, live, separations, settings.outside_signs);
-    detail::JobRunner jobs(input, params, settings, live, separations, check);
+    // The input's sides of the open layers near each vertex: what the local and the final
+    // checks keep (a rolled part stays rolled). Outside sides resolved for the untangling, or
+    // here when it does not run.
+    std::vector<int> outside_signs = settings.outside_signs;
+    if (outside_signs.empty())
+        for (std::size_t l = 0; l < input.size(); ++l)
+            outside_signs.push_back(outside_side(input, l));
+    const auto sides_start = Clock::now();
+    const InputSides input_sides = record_input_sides(input);
+    const double seconds_sides = seconds_since(sides_start);
+    const detail::LocalCheck check(input, live, separations, outside_signs, input_sides);
+    detail::JobRunner jobs(input, params, settings, live, separations, check, input_sides);
     detail::Scheduler scheduler(params, live, separations, check, jobs);
     SimplifyReport report = scheduler.run(progress);
     report.raised_separations = raised;
@@ -105,13 +115,14 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     auto start = Clock::now();
     CheckParams check_params;
     check_params.separation_tolerance = params.untangling.separation_tolerance;
-    // The input's open-layer sides (already resolved for the untangling, if any): vertex order
-    // is kept, and the vote of outside_side() is unreliable on layers simplified to a few
-    // vertices.
-    check_params.outside_sides = settings.outside_signs;
-    if (check_params.outside_sides.empty())
-        for (std::size_t l = 0; l < input.size(); ++l)
-            check_params.outside_sides.push_back(outside_side(input, l));
+    // The input's open-layer sides: vertex order is kept, and the vote of outside_side() is
+    // unreliable on layers simplified to a few vertices. The input is the reference of the
+    // local sides too: a nesting violation is a vertex that changed side.
+    check_params.outside_sides = outside_signs;
+    report.origins = live.origins();
+    report.rolled_vertices = input_sides.rolled_count(input, outside_signs);
+    const InputSides output_sides = input_sides.renumbered(report.origins);
+    check_params.input_sides = &output_sides;
     const CheckReport check_report = check_scene(out, check_params);
     report.crossings = check_report.crossing_count;
     report.self_crossings = check_report.total_self_crossings();
@@ -134,7 +145,7 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t l) {
         report.layers[l].hausdorff = hausdorff(out.layer(l), scene.layer(l), tolerance).symmetric();
     });
-    report.seconds_check += seconds_since(start);
+    report.seconds_check += seconds_since(start) + seconds_sides;  // the sides: a check's part
     scene = std::move(out);
     return report;
 }

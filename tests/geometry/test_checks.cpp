@@ -287,7 +287,9 @@ TEST_CASE("nesting against open layers uses their outside side", "[checks]") {
         CHECK(outside_side(scene, 0) == -1);  // the layer over is on the left
         const Scene far = test::stacked_sines(2, 100, 0.3, 1.0);
         CHECK(outside_side(far, 1, 2.0) == -1);
-        CHECK(outside_side(far, 1) == 1);  // nothing within the automatic near distance
+        // Nothing within the automatic near distance: the second vote, within 3 x that.
+        CHECK(outside_side(far, 1) == -1);
+        CHECK(outside_side(far, 1, 0.1) == 1);  // nothing within 0.3 either: +1
         Layer top = far.layer(1);
         std::reverse(top.points.begin(), top.points.end());
         const Scene reversed({far.layer(0), top});

@@ -14,6 +14,7 @@
 // schedule, threads), and exits 1. Exit 2: bad arguments.
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/io/json_io.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
@@ -93,10 +94,14 @@ std::vector<int> sides_of(const Scene& scene) {
     return sides;
 }
 
-CheckReport exact_check(const Scene& scene, const std::vector<int>& sides, double tolerance) {
+// `input_sides`: the sides recorded in the input, renumbered to `scene`'s vertices, or
+// nullptr (the global order).
+CheckReport exact_check(const Scene& scene, const std::vector<int>& sides, double tolerance,
+                        const InputSides* input_sides = nullptr) {
     CheckParams cp;
     cp.separation_tolerance = tolerance;
     cp.outside_sides = sides;
+    cp.input_sides = input_sides;
     return check_scene(scene, cp);
 }
 
@@ -176,7 +181,8 @@ int main(int argc, char** argv) {
         }
         const double tolerance = SimplifyParams{}.untangling.separation_tolerance;
         const std::vector<int> sides = sides_of(input);
-        const CheckReport in_check = exact_check(input, sides, tolerance);
+        const InputSides input_sides = record_input_sides(input);
+        const CheckReport in_check = exact_check(input, sides, tolerance, &input_sides);
         if (!(in_check.is_collision_free() && in_check.separations_hold())) {
             ++t.skipped_inputs;
             if (opt.verbose) std::printf("input not clean, skipped: %s\n", describe(c).c_str());
@@ -224,7 +230,10 @@ int main(int argc, char** argv) {
                                     describe(c).c_str(), decimator, remove, threads, e.what());
                         break;
                     }
-                    const CheckReport r = exact_check(out, sides, tolerance);
+                    // Nesting against the input's own sides (a rolled part stays rolled),
+                    // recorded here independently of simplify().
+                    const InputSides out_sides = input_sides.renumbered(report.origins);
+                    const CheckReport r = exact_check(out, sides, tolerance, &out_sides);
                     ++t.outputs_checked;
                     t.crossings += r.crossing_count;
                     t.self_crossings += r.total_self_crossings();
@@ -253,6 +262,17 @@ int main(int argc, char** argv) {
                             r.total_self_crossings(), r.nesting_violation_count,
                             r.separation_violation_count, r.min_separation_ratio,
                             report.collision_free ? "clean" : "not clean");
+                        if (opt.verbose)
+                            for (const NestingViolation& v : r.nesting_violations) {
+                                const std::size_t id = report.origins[v.layer][v.vertex];
+                                const Vec2 p = out.layer(v.layer).points[v.vertex];
+                                const Vec2 q = input.layer(v.layer).points[id];
+                                std::printf(
+                                    "  nesting: layer %zu vertex %zu (input %zu, side there %d) "
+                                    "at (%.9g, %.9g), input (%.9g, %.9g), against layer %zu\n",
+                                    v.layer, v.vertex, id, input_sides.side(v.layer, id, v.other),
+                                    p.x, p.y, q.x, q.y, v.other);
+                            }
                     }
                 }
                 if (!errored && !same_points(outputs[0], outputs[1])) {

@@ -3,6 +3,7 @@
 /// self-crossings, separations and nesting.
 
 #include "strata/core/types.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/geometry/scene.h"
 
 #include <cstddef>
@@ -26,6 +27,12 @@ struct CheckParams {
     /// vote of outside_side() is unreliable on an open layer simplified to 2 or 3 vertices.
     /// Empty: outside_side() of `scene` itself.
     std::vector<int> outside_sides;
+    /// Sides recorded in the scene the checked one comes from (record_input_sides(), then
+    /// InputSides::renumbered() to the checked scene's vertices), or nullptr. Where a vertex
+    /// has a recorded side of an open layer, the nesting against that layer asks for that side
+    /// (a rolled part stays rolled); elsewhere the global order decides, as without it. Not
+    /// owned; must outlive the call.
+    const InputSides* input_sides = nullptr;
 };
 
 /// Throws InvalidInput naming the first out-of-range field.
@@ -114,7 +121,8 @@ struct CheckReport {
 /// of it given by its outside side (see outside_side()), at vertices whose closest point on
 /// the open layer is within near_distance and not its end point. Inside / outside a closed
 /// layer is decided exactly (non-zero winding number with orient2d). Side-by-side pairs are
-/// not checked against open layers.
+/// not checked against open layers. With params.input_sides, a vertex with a recorded side of
+/// an open layer is checked against that side instead of the global one.
 ///
 /// Cost: an rtree broad phase for the contacts, O((n + k) log n) for n segments and k
 /// contacts; a nearest-segment query in a per-layer uniform grid per vertex and near layer
@@ -137,8 +145,10 @@ double automatic_near_distance(const Scene& scene);
 /// Closed: the sign of the signed area (counter-clockwise: +1). Open: each vertex of the
 /// layers directly under `i` whose closest point on `i` is closer than the near distance and
 /// not an end point of `i` votes for the side opposite to it; a tie (or no vote) passes to
-/// the vertices of the layers directly over `i`, which vote for their own side. The near
-/// distance is automatic_near_distance(scene).
+/// the vertices of the layers directly over `i`, which vote for their own side. When neither
+/// gives a vote, the same two votes are taken again within 3 x the near distance (neighbours
+/// at about the near distance, e.g. a gap equal to it). The near distance is
+/// automatic_near_distance(scene).
 int outside_side(const Scene& scene, std::size_t i);
 /// outside_side() with an explicit near distance (scene units, >= 0; 0 = automatic), as
 /// check_scene() uses it.  @throws InvalidInput bad near_distance.

@@ -28,13 +28,15 @@ bool is_waiting_stamp(const std::vector<Job>& waiting, std::uint32_t m) {
 
 JobRunner::JobRunner(const Scene& input, const SimplifyParams& params,
                      const EngineSettings& settings, LivePolylines& live,
-                     const Separations& separations, const LocalCheck& check)
+                     const Separations& separations, const LocalCheck& check,
+                     const InputSides& sides)
     : input_(input),
       params_(params),
       settings_(settings),
       live_(live),
       separations_(separations),
-      check_(check) {
+      check_(check),
+      sides_(sides) {
     slots_.mark.resize(live.size());
     for (std::size_t l = 0; l < live.size(); ++l)
         slots_.mark[l].assign(live.layer(l).alive.size(), 0);
@@ -172,6 +174,7 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
         job.settings.outside_signs.push_back(settings_.outside_signs[run.layer]);
     }
     job.work.emplace(std::move(work_layers));
+    local_sides(job);
     job.moving.clear();
     for (const Run& run : job.runs) {
         const WorkLayer& o = live_.layer(run.layer);
@@ -182,6 +185,39 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
     }
     job.seconds_prepare = seconds_since(start);
     return Prepared::Ready;
+}
+
+// The local sides of the job's vertices (RelationSource::local_sides): a vertex whose input
+// side of an open layer under or over its own is not the global order's keeps it in the job's
+// untangling, and one around an end of that layer keeps its distance on any side. Nothing is
+// set when the job has no such vertex.
+void JobRunner::local_sides(Job& job) const {
+    if (sides_.empty()) return;
+    const std::size_t runs = job.runs.size();
+    for (std::size_t r = 0; r < runs; ++r) {
+        const Run& run = job.runs[r];
+        for (std::size_t r2 = 0; r2 < runs; ++r2) {
+            const std::size_t other = job.runs[r2].layer;
+            if (other == run.layer || input_.layer(other).closed) continue;
+            const int wanted =
+                global_side(input_.relation(run.layer, other), settings_.outside_signs[other]);
+            if (wanted == 0) continue;
+            for (std::size_t k = 0; k < run.ids.size(); ++k) {
+                const std::size_t id = run.ids[k];
+                const int side = sides_.side(run.layer, id, other);
+                RelationSource::Side how = RelationSource::Side::Global;
+                if (sides_.beyond_end(run.layer, id, other))
+                    how = RelationSource::Side::AnySide;
+                else if (side != 0 && side != wanted)
+                    how = RelationSource::Side::Flipped;
+                if (how == RelationSource::Side::Global) continue;
+                auto& all = job.relations.local_sides;
+                if (all.empty()) all.resize(runs);
+                if (all[r].empty()) all[r].resize(run.ids.size());
+                all[r][k].push_back({r2, how});
+            }
+        }
+    }
 }
 
 void JobRunner::execute(Job& job) const {
@@ -220,7 +256,8 @@ void JobRunner::execute(Job& job) const {
         // Nesting of the region's vertices against every closed layer near it.
         for (const Run& run : job.runs)
             if (!check_.nesting_kept(run.layer, run.ids, ov)) return false;
-        return true;
+        // Sides of the open layers, as the input gives them (a rolled part stays rolled).
+        return check_.sides_kept(ov);
     };
     job.result = run_engine(*job.work, job.pieces, params_.untangling, job.relations, job.settings,
                             is_ok, {});

@@ -10,6 +10,7 @@
 #include "simplify/detail/local_check.h"
 #include "simplify/detail/separations.h"
 #include "simplify/detail/untangle_job.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/simplify/simplify.h"
 #include "untangle/detail/engine.h"
 
@@ -21,10 +22,12 @@ namespace strata::detail {
 
 class JobRunner {
   public:
-    /// `settings`: resolved for `input` (resolve_settings()). Keeps references to every
-    /// argument.
+    /// `settings`: resolved for `input` (resolve_settings()); `sides`: the input's sides
+    /// (record_input_sides(input)), which each job's untangling keeps. Keeps references to
+    /// every argument.
     JobRunner(const Scene& input, const SimplifyParams& params, const EngineSettings& settings,
-              LivePolylines& live, const Separations& separations, const LocalCheck& check);
+              LivePolylines& live, const Separations& separations, const LocalCheck& check,
+              const InputSides& sides);
 
     enum class Prepared { Ready, Conflict, Refused };
 
@@ -40,6 +43,7 @@ class JobRunner {
     void apply(const Job& job);
 
   private:
+    void local_sides(Job& job) const;
     void mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked,
               const std::vector<Job>& waiting);
     bool is_marked(std::size_t k, std::size_t v) const {
@@ -54,6 +58,7 @@ class JobRunner {
     LivePolylines& live_;
     const Separations& separations_;
     const LocalCheck& check_;
+    const InputSides& sides_;
     JobSlots slots_;
     std::uint32_t mark_counter_ = 0;  // stamp of the job being prepared
     bool conflict_ = false;           // prepare() met a waiting job

@@ -83,17 +83,27 @@ void LivePolylines::move(std::size_t l, std::size_t v, const Vec2& to) {
     if (w.next[v] != kNone) grid_.insert(ref(l, v), seg_box(l, v));
 }
 
-Scene LivePolylines::to_scene(const Scene& input) const {
-    std::vector<Layer> layers = input.layers();
-    for (std::size_t l = 0; l < layers.size(); ++l) {
+std::vector<std::vector<std::size_t>> LivePolylines::origins() const {
+    std::vector<std::vector<std::size_t>> ids(layers_.size());
+    for (std::size_t l = 0; l < layers_.size(); ++l) {
         const WorkLayer& w = layers_[l];
-        std::vector<Vec2> points;
         const std::size_t start = w.first();
         std::size_t i = start;
         do {
-            points.push_back(w.pos[i]);
+            ids[l].push_back(i);
             i = w.next[i];
         } while (i != kNone && i != start);
+    }
+    return ids;
+}
+
+Scene LivePolylines::to_scene(const Scene& input) const {
+    std::vector<Layer> layers = input.layers();
+    const std::vector<std::vector<std::size_t>> ids = origins();
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+        std::vector<Vec2> points;
+        points.reserve(ids[l].size());
+        for (std::size_t i : ids[l]) points.push_back(layers_[l].pos[i]);
         layers[l].points = std::move(points);
     }
     Scene out(std::move(layers), input.units());

@@ -46,6 +46,8 @@ class LivePolylines {
 
     /// `input` (layers, metadata) with the alive vertices of every layer, in order.
     Scene to_scene(const Scene& input) const;
+    /// Per layer, the input id of every vertex of to_scene(), in the same order.
+    std::vector<std::vector<std::size_t>> origins() const;
     /// Largest distance of an alive vertex of layer l from its input position.
     double max_displacement(std::size_t l) const;
 

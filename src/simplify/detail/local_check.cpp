@@ -1,5 +1,6 @@
 #include "simplify/detail/local_check.h"
 
+#include "strata/geometry/checks.h"
 #include "strata/geometry/predicates.h"
 
 #include <algorithm>
@@ -33,6 +34,25 @@ bool apart_by_more(const Box2& a, const Box2& b, double d) {
 }
 
 }  // namespace
+
+LocalCheck::LocalCheck(const Scene& input, const LivePolylines& live,
+                       const Separations& separations, const std::vector<int>& outside_signs,
+                       const InputSides& sides)
+    : input_(input),
+      live_(live),
+      separations_(separations),
+      outside_signs_(outside_signs),
+      sides_(sides),
+      reach_(automatic_near_distance(input)) {
+    for (std::size_t k = 0; k < input.size() && !open_nesting_; ++k)
+        for (std::size_t j = 0; j < input.size() && !input.layer(k).closed; ++j) {
+            const Relation r = input.relation(j, k);
+            if (r == Relation::Under || r == Relation::Over) {
+                open_nesting_ = true;
+                break;
+            }
+        }
+}
 
 bool LocalCheck::removal_clear(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
                                const Overlay& ov) const {
@@ -187,6 +207,98 @@ bool LocalCheck::nesting_kept(std::size_t l, const std::vector<std::size_t>& ids
             }
             if (change != 0) return false;
         }
+    }
+    return true;
+}
+
+int LocalCheck::side_against(std::size_t k, const Vec2& p, const Overlay& ov) const {
+    const WorkLayer& w = live_.layer(k);
+    Box2 box;
+    box.extend(p);
+    double best = reach_;
+    std::size_t seg = kNone;
+    Vec2 closest{0.0};
+    // Boxes growing from the largest separation to reach_: every segment closer than r meets
+    // the box inflated by r, so a closest one found within r is the closest.
+    for (double r = std::min(reach_, std::max(separations_.max_reach, 1e-3 * reach_));;
+         r = std::min(reach_, 2.0 * r)) {
+        best = reach_;
+        seg = kNone;
+        ov.near(box.inflated(r), [&](std::size_t j, std::size_t u) {
+            if (j != k) return;
+            const Vec2 a = ov.pos(k, u), b = ov.pos(k, w.next[u]);
+            if (a == b) return;  // zero length: its point is an end of its neighbours
+            Vec2 c;
+            const double d = point_segment_distance(p, a, b, &c);
+            // check_scene(): the segment of smallest index among equally close ones (input
+            // ids run in layer order on an open layer).
+            if (d < best || (d == best && seg != kNone && u < seg)) {
+                best = d;
+                seg = u;
+                closest = c;
+            }
+        });
+        if ((seg != kNone && best <= r) || r >= reach_) break;
+    }
+    if (seg == kNone || best == 0.0) return 0;
+    const std::size_t e = w.next[seg];
+    const Vec2 a = ov.pos(k, seg), b = ov.pos(k, e);
+    if (closest == a) {
+        if (w.prev[seg] == kNone) return 0;  // an end of the open layer
+        return corner_side(ov.pos(k, w.prev[seg]), a, b, p);
+    }
+    if (closest == b) {
+        if (w.next[e] == kNone) return 0;
+        return corner_side(a, b, ov.pos(k, w.next[e]), p);
+    }
+    return segment_side(a, b, p);
+}
+
+bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
+                             std::size_t only) const {
+    const Vec2 p = ov.pos(j, x);
+    for (std::size_t k = 0; k < live_.size(); ++k) {
+        if (k == j || live_.layer(k).closed || (only != kNone && k != only)) continue;
+        const Relation r = input_.relation(j, k);
+        if (r != Relation::Under && r != Relation::Over) continue;
+        int wanted = sides_.side(j, x, k);
+        if (wanted == 0) wanted = global_side(r, outside_signs_[k]);
+        const int side = side_against(k, p, ov);
+        if (side != 0 && side != wanted) return false;
+    }
+    return true;
+}
+
+bool LocalCheck::sides_kept(const Overlay& ov) const {
+    if (!open_nesting_) return true;
+    const Job& job = *ov.job();
+    for (std::size_t r = 0; r < job.runs.size(); ++r) {
+        const Run& run = job.runs[r];
+        const WorkLayer& w = live_.layer(run.layer);
+        Box2 moved;  // the run's free vertices before and after, and the removed vertex
+        bool any = false;
+        for (std::size_t i = 0; i < run.ids.size(); ++i) {
+            if (!job.pieces[r].is_free[i]) continue;
+            any = true;
+            if (!keeps_sides(run.layer, run.ids[i], ov)) return false;
+            moved.extend(w.pos[run.ids[i]]);
+            moved.extend(ov.pos(run.layer, run.ids[i]));
+        }
+        if (run.layer == job.l) {
+            any = true;
+            moved.extend(job.removed);
+        }
+        if (!any || w.closed) continue;
+        // The other layers' vertices near where this open layer changed.
+        bool ok = true;
+        ov.near(moved.inflated(reach_), [&](std::size_t j, std::size_t u) {
+            if (!ok || j == run.layer) return;
+            const std::size_t v = live_.layer(j).next[u];
+            if (!keeps_sides(j, u, ov, run.layer) ||
+                (v != kNone && !keeps_sides(j, v, ov, run.layer)))
+                ok = false;
+        });
+        if (!ok) return false;
     }
     return true;
 }

@@ -8,6 +8,7 @@
 #include "simplify/detail/live_polylines.h"
 #include "simplify/detail/separations.h"
 #include "simplify/detail/untangle_job.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/geometry/scene.h"
 
 #include <cstddef>
@@ -17,11 +18,11 @@ namespace strata::detail {
 
 class LocalCheck {
   public:
-    /// `outside_signs`: outside_side() of every layer of `input`; read only by the checks
-    /// over a job. Keeps references to every argument.
+    /// `outside_signs`: outside_side() of every layer of `input`; `sides`: the input's sides
+    /// (record_input_sides(input)), by input vertex id. Both read only by the checks over a
+    /// job. Keeps references to every argument.
     LocalCheck(const Scene& input, const LivePolylines& live, const Separations& separations,
-               const std::vector<int>& outside_signs)
-        : input_(input), live_(live), separations_(separations), outside_signs_(outside_signs) {}
+               const std::vector<int>& outside_signs, const InputSides& sides);
 
     /// The removal of the vertex at `removed` between a and b (unlinked) of layer l: layer l
     /// stays valid, the closed triangle (a, removed, b) holds no other vertex, and the chord
@@ -34,8 +35,22 @@ class LocalCheck {
     bool closed_valid(std::size_t l, const Overlay& ov) const;
     /// Over a job: every vertex of `ids` (layer l) stays on its side of every closed layer.
     bool nesting_kept(std::size_t l, const std::vector<std::size_t>& ids, const Overlay& ov) const;
+    /// Over a job: every vertex it moves, and every vertex near the segments it moves of an
+    /// open layer, is on the side of each open layer under or over its own that the input
+    /// gives it (`sides`), or that the global order asks for where the input gives none, as
+    /// check_scene() judges it (the side at the closest point within the near distance of
+    /// the input, automatic_near_distance()). A vertex carried around the end of an open layer
+    /// crosses nothing; this is what catches it.
+    bool sides_kept(const Overlay& ov) const;
 
   private:
+    /// check_scene()'s side of open layer k at p, at the overlay's positions (0: nothing
+    /// closer than reach_, closest to an end, or on the layer).
+    int side_against(std::size_t k, const Vec2& p, const Overlay& ov) const;
+    /// Vertex x of layer j, at its overlay position, is on its wanted side of every open layer
+    /// k it nests with (or of `only` when given).
+    bool keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
+                     std::size_t only = static_cast<std::size_t>(-1)) const;
     bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
                         const Vec2& w) const;
     bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
@@ -47,6 +62,9 @@ class LocalCheck {
     const LivePolylines& live_;
     const Separations& separations_;
     const std::vector<int>& outside_signs_;
+    const InputSides& sides_;
+    double reach_ = 0.0;         // check_scene()'s automatic near distance of the input
+    bool open_nesting_ = false;  // some open layer is under or over another layer
 };
 
 }  // namespace strata::detail

@@ -110,6 +110,7 @@ class Pass {
     Pass(const Scene& work, const RelationSource& relations, const SceneFields& fields,
          const UntangleParams& params, double min_separation, double sample_spacing)
         : fields_(fields),
+          relations_(relations),
           params_(params),
           sample_spacing_(sample_spacing),
           scratch_([&params] { return Scratch(params.composition); }) {
@@ -153,7 +154,10 @@ class Pass {
     }
 
     // The composed value and gradient of `layer` at x (thread-safe with one Scratch per thread).
-    Composed compose_at(std::size_t layer, const Vec2& x, Scratch& s) const {
+    // `local`: the layers whose field x takes otherwise than the global order says (local
+    // sides, see RelationSource::local_sides), or nullptr.
+    Composed compose_at(std::size_t layer, const Vec2& x, Scratch& s,
+                        const std::vector<RelationSource::LocalSide>* local = nullptr) const {
         // Only layers whose band box holds x can take part: the others are not sampled.
         s.samples.resize(fields_.size());
         s.f.clear();
@@ -165,7 +169,9 @@ class Pass {
         for (std::size_t j = 0; j < s.samples.size(); ++j) {
             if (j == layer || !band_boxes_[j].contains(x)) continue;
             s.samples[j] = fields_.field(j).sample_in_band(x);
-            if (s.samples[j].in_band && s.samples[j].border > 0.0) s.members.push_back(j);
+            if (!(s.samples[j].in_band && s.samples[j].border > 0.0)) continue;
+            s.members.push_back(j);
+            if (local) take_local_side(layer, j, *local, s.samples[j]);
         }
         Composed out;
         out.f = s.samples[layer].value;
@@ -179,6 +185,28 @@ class Pass {
             compose_general_at(s, out);
         out.is_violated = std::abs(out.fhat - out.f) > 1e-12 * (1.0 + std::abs(out.f));
         return out;
+    }
+
+    // Sample j of the point of `layer` as its local side says: Flipped, the sign changed (the
+    // composition sees the point on the other side of j and pushes it away from j there);
+    // AnySide, the sign the nesting wants (only the distance to j is kept).
+    void take_local_side(std::size_t layer, std::size_t j,
+                         const std::vector<RelationSource::LocalSide>& local,
+                         FieldSample& sample) const {
+        for (const RelationSource::LocalSide& x : local) {
+            if (x.layer != j) continue;
+            bool flip = x.side == RelationSource::Side::Flipped;
+            if (x.side == RelationSource::Side::AnySide) {
+                const Relation r = relation_[layer * fields_.size() + j];
+                flip = (r == Relation::Under && sample.value > 0.0) ||
+                       (r == Relation::Over && sample.value < 0.0);
+            }
+            if (flip) {
+                sample.value = -sample.value;
+                sample.gradient = -sample.gradient;
+            }
+            return;
+        }
     }
 
     // compose_at() with any constraint set: the members' pairwise constraints, `layer` first.
@@ -320,7 +348,9 @@ class Pass {
                     const std::size_t k = index - offset[p];
                     if (is_vertex) {
                         if (piece.is_free[k]) {
-                            const Composed c = compose_at(piece.layer, x[piece.vertices[k]], s);
+                            const Composed c =
+                                compose_at(piece.layer, x[piece.vertices[k]], s,
+                                           relations_.local_at(piece.layer, piece.vertices[k]));
                             violation_[i] = std::abs(c.fhat - c.f);
                             own_[i] = step_toward_zero(c);
                         }
@@ -330,8 +360,12 @@ class Pass {
                     if (!piece.is_free[k] && !piece.is_free[k2]) continue;
                     const Vec2 a = x[piece.vertices[k]], b = x[piece.vertices[k2]];
                     edge_samples(scene, piece.layer, a, b, s.ts);
+                    const auto* local_a = relations_.local_at(piece.layer, piece.vertices[k]);
+                    const auto* local_b = relations_.local_at(piece.layer, piece.vertices[k2]);
                     for (double t : s.ts) {
-                        const Composed c = compose_at(piece.layer, a + t * (b - a), s);
+                        // An edge's points take the local sides of its nearer end.
+                        const Composed c = compose_at(piece.layer, a + t * (b - a), s,
+                                                      t < 0.5 ? local_a : local_b);
                         if (!c.is_violated) continue;
                         violation_[i] = std::max(violation_[i], std::abs(c.fhat - c.f));
                         const Vec2 d = step_toward_zero(c);
@@ -428,6 +462,7 @@ class Pass {
 
   private:
     const SceneFields& fields_;
+    const RelationSource& relations_;
     const UntangleParams& params_;
     double sample_spacing_ = 0.0;
     double reach_ = 0.0;  // how far from an edge a vertex of another layer gets its own sample

@@ -24,6 +24,37 @@ struct RelationSource {
         return of(a) == of(b) ? 0.0 : scene->required_separation(of(a), of(b));
     }
     double weight(std::size_t a) const { return scene->layer(of(a)).weight; }
+
+    /// How a vertex takes the field of another layer (local sides, input_sides.h).
+    enum class Side : unsigned char {
+        Global,   ///< As the global order says.
+        Flipped,  ///< On the other side: f_j with its sign changed (a rolled part).
+        AnySide,  ///< Around an end of open layer j: only the distance counts.
+    };
+    struct LocalSide {
+        std::size_t layer = 0;  ///< The other work layer j (open).
+        Side side = Side::Global;
+    };
+    /// local_sides[i][k]: the work layers whose field vertex k of work layer i takes otherwise
+    /// than the global order says, as the input has it. There the composition takes f_j with
+    /// its sign changed (Flipped) or with the sign the nesting wants (AnySide: |f_j| kept),
+    /// and the finishing stage wants the other side (Flipped) or any side (AnySide).
+    /// Empty (or an empty entry): the global order.
+    std::vector<std::vector<std::vector<LocalSide>>> local_sides;
+
+    /// The local sides of vertex k of work layer i, or nullptr when none.
+    const std::vector<LocalSide>* local_at(std::size_t i, std::size_t k) const {
+        if (i >= local_sides.size() || k >= local_sides[i].size() || local_sides[i][k].empty())
+            return nullptr;
+        return &local_sides[i][k];
+    }
+    /// How vertex k of work layer i takes work layer j.
+    Side side_of(std::size_t i, std::size_t k, std::size_t j) const {
+        if (const std::vector<LocalSide>* all = local_at(i, k))
+            for (const LocalSide& x : *all)
+                if (x.layer == j) return x.side;
+        return Side::Global;
+    }
 };
 
 /// Scene-wide settings of the engine, resolved once.

@@ -147,7 +147,7 @@ class Finisher {
   public:
     Finisher(Scene& work, const std::vector<Piece>& pieces, const RelationSource& relations,
              const SeparationParams& params)
-        : work_(work), params_(params) {
+        : work_(work), relations_(relations), params_(params) {
         const std::size_t n = work.size();
         for (std::size_t l = 0; l < n; ++l) {
             pts_.push_back(work.layer(l).points);
@@ -289,7 +289,7 @@ class Finisher {
         for (Nearest& x : nearest_) {
             const SegId& s = found_[x.index];
             const Vec2 q0 = cells_->start(s), q1 = cells_->end(s), p = pts_[l][v];
-            const int wanted = wanted_side(l, s.layer);
+            const int wanted = wanted_side(l, v, s.layer);
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
                          orient2d(q0, q1, p) != wanted;
         }
@@ -314,7 +314,7 @@ class Finisher {
             double shortfall = aim - d;
             if (near.is_wrong) {  // over to the side it belongs on, at the aim
                 const Vec2 left(-e.y, e.x);  // orient2d(q0, q1, q0 + left) = +1
-                normal = static_cast<double>(wanted_side(l, m)) * left / std::sqrt(e2);
+                normal = static_cast<double>(wanted_side(l, v, m)) * left / std::sqrt(e2);
                 shortfall = aim + d;
                 ++wrong_side_;
             } else if (!(d < aim)) {
@@ -346,14 +346,23 @@ class Finisher {
 
     // The side of layer m's segments (orient2d sign) that layer l's vertices must be on, by
     // the nesting: inside m when l is under m, outside when over; 0 when any side will do
-    // (side-by-side layers push apart whatever the side).
-    int wanted_side(std::size_t l, std::size_t m) const {
+    // (side-by-side layers push apart whatever the side). Vertex v keeps the other side where
+    // the input has it there, or any side around an end of m (RelationSource::local_sides).
+    int wanted_side(std::size_t l, std::size_t v, std::size_t m) const {
         const Relation r = relation_[l * pts_.size() + m];
         if (r == Relation::SideBySide || params_.outside_signs == nullptr ||
             m >= params_.outside_signs->size())
             return 0;
         const int outside = (*params_.outside_signs)[m];  // +1: outside on the right
-        return r == Relation::Under ? outside : -outside;
+        const int wanted = r == Relation::Under ? outside : -outside;
+        switch (relations_.side_of(l, v, m)) {
+            case RelationSource::Side::Flipped:
+                return -wanted;
+            case RelationSource::Side::AnySide:
+                return 0;
+            default:
+                return wanted;
+        }
     }
 
     // Moves vertex (l, v) by `delta`, or by a half, a quarter or an eighth of it when the full
@@ -424,6 +433,7 @@ class Finisher {
     }
 
     Scene& work_;
+    const RelationSource& relations_;
     const SeparationParams& params_;
     std::vector<std::vector<Vec2>> pts_;
     std::vector<char> closed_;

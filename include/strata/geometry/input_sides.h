@@ -1,0 +1,97 @@
+#pragma once
+/// @file Sides from the input: for each vertex near an open layer, the side of that layer it
+/// lies on in the input. A rolled sleeve or a turned-back cuff has part of an inner layer lying
+/// on top of an outer one without any crossing; there the global order (every vertex of a
+/// layer below every layer above it) does not hold, and the input's own local side is the
+/// order to keep. Far from the other layer the input says nothing and the global order
+/// decides, as it does everywhere for closed layers (inside / outside is global there).
+
+#include "strata/geometry/scene.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace strata {
+
+/// Parameters of record_input_sides(). Lengths are in scene units.
+struct InputSideParams {
+    /// A vertex gets a side of an open layer when its closest point there is closer than this
+    /// (and not an end point of the layer). 0 = automatic: 3 x the exact check's automatic
+    /// near distance (automatic_near_distance(): max(5% of the bounding-box diagonal, 2 x the
+    /// largest required separation)), the distance within which check_scene() judges sides.
+    /// More than that distance, so that a rolled part lying a few gaps over the other layer
+    /// (farther than the near distance in the input) keeps its side when the simplification
+    /// brings it closer. A vertex farther than the reach is judged by the global order. >= 0.
+    double reach = 0.0;
+};
+
+/// Throws InvalidInput naming the first out-of-range field.
+void validate(const InputSideParams& params);
+
+/// The recorded sides. side(a, k, b) is the side of open layer b that vertex k of layer a lies
+/// on: +1 right of b's direction of travel, -1 left, 0 nothing recorded (b closed, a and b side
+/// by side, farther than the reach, closest to an end point of b, or on b).
+class InputSides {
+  public:
+    InputSides() = default;
+
+    /// Number of layers (0: nothing recorded).
+    std::size_t size() const { return n_; }
+    bool empty() const { return n_ == 0; }
+    /// See the class comment; 0 for indices out of range.
+    int side(std::size_t a, std::size_t k, std::size_t b) const {
+        const int s = code(a, k, b);
+        return s == kBeyondEnd ? 0 : s;
+    }
+    /// Vertex k of layer a is within the reach of open layer b but closest to one of its end
+    /// points (around the end of b, e.g. on the bend of a roll): it has no side of b.
+    bool beyond_end(std::size_t a, std::size_t k, std::size_t b) const {
+        return code(a, k, b) == kBeyondEnd;
+    }
+    /// The same sides for a scene with the same layers whose vertex k of layer a is vertex
+    /// origin[a][k] of the recorded one (a simplification keeps vertices and their order).
+    /// @throws InvalidInput when origin has the wrong layer count or an index out of range.
+    InputSides renumbered(const std::vector<std::vector<std::size_t>>& origin) const;
+    /// The sides for `scene`, whose layers are those of `reference` (the scene these sides were
+    /// recorded in) matched by name, when the vertex correspondence is not known (`strata
+    /// check --reference`): each vertex takes the sides of the reference vertex that ends the
+    /// closest segment of its layer's reference nearest to it. Layers without a namesake get
+    /// none. Defined in checks.cpp (nearest queries).
+    static InputSides matched(const InputSides& recorded, const Scene& reference,
+                              const Scene& scene);
+    /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
+    /// outside_side() per layer): the rolled or folded-over vertices, once per other layer.
+    std::size_t rolled_count(const Scene& scene, const std::vector<int>& outside_sides) const;
+
+  private:
+    static constexpr signed char kBeyondEnd = 2;
+    int code(std::size_t a, std::size_t k, std::size_t b) const {
+        if (a >= n_ || b >= n_) return 0;
+        const std::vector<signed char>& s = sides_[a * n_ + b];
+        return k < s.size() ? s[k] : 0;
+    }
+    friend InputSides record_input_sides(const Scene&, const InputSideParams&);
+    std::size_t n_ = 0;
+    std::vector<std::vector<signed char>> sides_;  // [a * n + b][k]
+};
+
+/// @brief Records the side of every vertex of `scene` against every open layer under or over
+/// its own layer within params.reach, with the rule check_scene() uses (the side at the
+/// closest point; at a corner, the side of the corner's wedge).
+/// @throws InvalidInput bad params.
+InputSides record_input_sides(const Scene& scene, const InputSideParams& params = {});
+
+/// The side rule of check_scene() where the closest point of a polyline to `v` is the corner
+/// `w` between its segments (u, w) and (w, x): +1 right of the direction of travel, -1 left.
+/// The side of the corner's inner wedge is the one v is on when it lies in that wedge (on both
+/// segments' inner side); straight corners fall back to the segments' own sides.
+int corner_side(const Vec2& u, const Vec2& w, const Vec2& x, const Vec2& v);
+/// The side rule where the closest point is inside segment (a, b): -orient2d(a, b, v).
+int segment_side(const Vec2& a, const Vec2& b, const Vec2& v);
+
+/// The side of open layer b that a vertex of layer a must lie on by the global order:
+/// -outside (the inside) when a is under b, +outside when over, 0 otherwise (side by side,
+/// same layer). `outside`: outside_side() of b.
+int global_side(Relation relation_of_a_to_b, int outside);
+
+}  // namespace strata

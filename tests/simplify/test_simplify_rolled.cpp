@@ -1,0 +1,377 @@
+// Rolled layers (issue 19): an inner layer that comes around the end of the outer one and lies
+// on top of it. The input's own sides are the order to keep there (input_sides.h).
+#include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
+#include "strata/simplify/scene_families.h"
+#include "strata/simplify/simplify.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+using namespace strata;
+
+namespace {
+
+std::vector<int> outside_sides(const Scene& scene) {
+    std::vector<int> sides;
+    for (std::size_t l = 0; l < scene.size(); ++l) sides.push_back(outside_side(scene, l));
+    return sides;
+}
+
+std::vector<std::vector<std::size_t>> identity(const Scene& scene) {
+    std::vector<std::vector<std::size_t>> ids;
+    for (const Layer& layer : scene.layers()) {
+        ids.emplace_back(layer.points.size());
+        std::iota(ids.back().begin(), ids.back().end(), std::size_t{0});
+    }
+    return ids;
+}
+
+// Gap between the layers of a rolled scene, scene units (scene_families.cpp).
+double rolled_gap(const FamilyParams& p) {
+    return p.gap * 10.0 / static_cast<double>(p.points - 1);
+}
+
+}  // namespace
+
+TEST_CASE("the input's sides record the roll; a vertex that changes side is flagged", "[rolled]") {
+    for (double gap : {1.0, 2.0, 4.0}) {
+        INFO("gap " << gap);
+        FamilyParams params;
+        params.points = 300;
+        params.gap = gap;
+        const Scene scene = make_scene(SceneFamily::Rolled, params);
+        const InputSides sides = record_input_sides(scene);
+        const std::vector<int> outside = outside_sides(scene);
+        // Inner (0) under outer (1); the roll's top part lies over the outer layer.
+        CHECK(sides.rolled_count(scene, outside) > 0);
+
+        CheckParams cp;
+        cp.outside_sides = outside;
+        const InputSides own = sides.renumbered(identity(scene));
+        cp.input_sides = &own;
+        const CheckReport against_itself = check_scene(scene, cp);
+        CHECK(against_itself.crossing_count == 0);
+        CHECK(against_itself.nesting_violation_count == 0);
+
+        // The roll's top part moved under the inner's own base: those vertices left the side
+        // of the outer layer the input gives them (the segments joining them to the roll's
+        // arc cross too; what is checked here is the nesting).
+        std::vector<Layer> layers = scene.layers();
+        const double g = rolled_gap(params);
+        std::size_t moved = 0;
+        for (Vec2& p : layers[0].points)
+            if (p.y > 2.5 * g && p.x < 8.0) {
+                p.y = -2.0 * g;  // under the inner's own base: the order of the input is lost
+                ++moved;
+            }
+        REQUIRE(moved > 0);
+        const Scene flipped(layers);
+        const CheckReport changed = check_scene(flipped, cp);
+        CHECK(changed.nesting_violation_count > 0);
+    }
+}
+
+TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolled]") {
+    const char* const decimators[] = {"random", "visvalingam", "max-error"};
+    for (double gap : {2.0, 4.0}) {
+        FamilyParams fp;
+        fp.points = 600;
+        fp.gap = gap;
+        const Scene input = make_scene(SceneFamily::Rolled, fp);
+        const double g = rolled_gap(fp);
+        const std::vector<int> outside = outside_sides(input);
+        const InputSides sides = record_input_sides(input);
+        REQUIRE(sides.rolled_count(input, outside) > 0);
+        for (const char* decimator : decimators)
+            for (double remove : {0.9, 0.95})
+                for (UntangleSchedule schedule :
+                     {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                    INFO("gap " << gap << " " << decimator << " remove " << remove
+                                << (schedule == UntangleSchedule::Deferred ? " deferred"
+                                                                           : " immediate"));
+                    SimplifyParams params;
+                    params.decimator = decimator;
+                    params.remove = remove;
+                    params.schedule = schedule;
+                    Scene out = input;
+                    const SimplifyReport report = simplify(out, params);
+                    CHECK(report.collision_free);
+                    // The rolled layer meets its budget. (The outer one is a straight line:
+                    // its collinear removals are refused the same way without the roll, a
+                    // weakness of the driver's local test, not of the sides.)
+                    // Budget and shape below: asked of the error-driven decimators with the
+                    // default, deferred schedule. The immediate schedule stays clean but
+                    // refuses most removals of the rolled layer (measured at 600 points, gap
+                    // 2: 577 vertices left for a target of 79, Hausdorff 0.12 to 0.34).
+                    const bool shape_asked = std::string(decimator) != "random" &&
+                                             schedule == UntangleSchedule::Deferred;
+                    if (shape_asked) CHECK(report.layers[0].after <= report.layers[0].target);
+                    CHECK(report.rolled_vertices > 0);
+
+                    // Checked here again, independently of simplify()'s own check.
+                    CheckParams cp;
+                    cp.outside_sides = outside;
+                    cp.separation_tolerance = params.untangling.separation_tolerance;
+                    const InputSides out_sides = sides.renumbered(report.origins);
+                    cp.input_sides = &out_sides;
+                    const CheckReport check = check_scene(out, cp);
+                    CHECK(check.crossing_count == 0);
+                    CHECK(check.total_self_crossings() == 0);
+                    CHECK(check.nesting_violation_count == 0);
+                    CHECK(check.separation_violation_count == 0);
+                    CHECK(check.min_separation_ratio >= 0.9);
+                    // The shape: within 2 gaps of the input. Not asked of the random
+                    // decimator, which may remove the whole bend of the roll and leave the
+                    // untangling to pull the layer around the end of the other one (measured:
+                    // Hausdorff 0.75 = 22 gaps on gap 2, clean; README, what is missing).
+                    if (shape_asked)
+                        for (std::size_t l = 0; l < out.size(); ++l)
+                            CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * g).symmetric() <=
+                                  2.0 * g);
+                    // The roll is kept: the top of the roll (input y = 3 gaps, over the outer
+                    // layer at y = gap) stays over the outer layer.
+                    const Layer& inner = out.layer(0);
+                    for (std::size_t k = 0; k < inner.points.size(); ++k) {
+                        const Vec2 was = input.layer(0).points[report.origins[0][k]];
+                        if (was.y > 2.5 * g && was.x < 8.0) CHECK(inner.points[k].y > 1.5 * g);
+                    }
+                }
+    }
+}
+
+namespace {
+
+// A rolled scene with waves (the generated family's layers are straight lines, whose collinear
+// removals the driver refuses with or without a roll): inner base y = w(x) on [0, 9], a half
+// circle of radius 1.5 gaps around x = 9, the top back to x = 5 at 3 gaps; the outer layer at
+// 1 gap over [0, 8]; w(x) = 0.3 gap sin 2x. Thickness half the gap (required: half the gap).
+Scene wavy_roll(std::size_t points, double gap_in_segments) {
+    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
+    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
+    Layer inner, outer;
+    inner.name = "inner";
+    outer.name = "outer";
+    inner.thickness = outer.thickness = 0.5 * g;
+    for (double x = 0.0; x <= 8.0 + 1e-9; x += s) outer.points.emplace_back(x, g + w(x));
+    for (double x = 0.0; x < 9.0; x += s) inner.points.emplace_back(x, w(x));
+    const double r = 1.5 * g, pi = 3.14159265358979323846;
+    const int steps = std::max(4, static_cast<int>(std::ceil(pi * r / s)));
+    for (int j = 1; j < steps; ++j) {
+        const double a = -0.5 * pi + pi * j / steps;
+        inner.points.emplace_back(9.0 + r * std::cos(a), r + r * std::sin(a) + w(9.0));
+    }
+    for (double x = 9.0; x >= 5.0; x -= s) inner.points.emplace_back(x, 3.0 * g + w(x));
+    return Scene({inner, outer});
+}
+
+}  // namespace
+
+TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
+    for (double gap : {2.0, 4.0}) {
+        const Scene input = wavy_roll(600, gap);
+        const double g = gap * 10.0 / 599.0;
+        const std::vector<int> outside = outside_sides(input);
+        const InputSides sides = record_input_sides(input);
+        REQUIRE(sides.rolled_count(input, outside) > 0);
+        for (const char* decimator : {"visvalingam", "max-error"})
+            for (double remove : {0.9, 0.95})
+                for (UntangleSchedule schedule :
+                     {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                    INFO("gap " << gap << " " << decimator << " remove " << remove
+                                << (schedule == UntangleSchedule::Deferred ? " deferred"
+                                                                           : " immediate"));
+                    SimplifyParams params;
+                    params.decimator = decimator;
+                    params.remove = remove;
+                    params.schedule = schedule;
+                    Scene out = input;
+                    const SimplifyReport report = simplify(out, params);
+                    CHECK(report.collision_free);
+                    CHECK(report.targets_met);
+                    CheckParams cp;
+                    cp.outside_sides = outside;
+                    cp.separation_tolerance = params.untangling.separation_tolerance;
+                    const InputSides out_sides = sides.renumbered(report.origins);
+                    cp.input_sides = &out_sides;
+                    const CheckReport check = check_scene(out, cp);
+                    CHECK(check.crossing_count == 0);
+                    CHECK(check.nesting_violation_count == 0);
+                    CHECK(check.min_separation_ratio >= 0.9);
+                    for (std::size_t l = 0; l < out.size(); ++l)
+                        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * g).symmetric() <=
+                              2.0 * g);
+                }
+    }
+}
+
+namespace {
+
+// Both layers rolled together, around a centre at (9, 1.5 gaps): the inner layer (base y = 0)
+// takes the outside of the bend (radius 1.5 gaps), the outer one (base y = 1 gap) its inside
+// (radius 0.5 gap); back on top, the inner layer lies over the outer one: the order flips.
+// Same waves as wavy_roll().
+Scene both_rolled(std::size_t points, double gap_in_segments) {
+    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
+    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
+    const double pi = 3.14159265358979323846;
+    Layer inner, outer;
+    inner.name = "inner";
+    outer.name = "outer";
+    inner.thickness = outer.thickness = 0.25 * g;  // required: half a gap, as on the bend
+    auto roll = [&](Layer& layer, double base, double radius) {
+        for (double x = 0.0; x < 9.0; x += s) layer.points.emplace_back(x, base + w(x));
+        const int steps = std::max(4, static_cast<int>(std::ceil(pi * radius / s)));
+        for (int j = 1; j < steps; ++j) {
+            const double a = -0.5 * pi + pi * j / steps;
+            layer.points.emplace_back(9.0 + radius * std::cos(a),
+                                      1.5 * g + radius * std::sin(a) + w(9.0));
+        }
+        for (double x = 9.0; x >= 5.0; x -= s) layer.points.emplace_back(x, 3.0 * g - base + w(x));
+    };
+    roll(inner, 0.0, 1.5 * g);
+    roll(outer, g, 0.5 * g);
+    return Scene({inner, outer});
+}
+
+// A shirt rolled over the end of a jacket, both over a closed body: body radius 1 (closed,
+// under the shirt), shirt at 1 + gap over angles [0.5, 5], jacket at 1 + 2 gaps over
+// [0.5, 5 - 4 gaps]; at angle 5 the shirt turns outward around a half circle of radius 1 gap
+// and comes back at 1 + 3 gaps (over the jacket) to angle 4.
+Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments) {
+    const double s = 2.0 * 3.14159265358979323846 / static_cast<double>(points);
+    const double g = gap_in_segments * s, pi = 3.14159265358979323846;
+    auto at = [](double r, double t) { return Vec2(r * std::cos(t), r * std::sin(t)); };
+    Layer body, shirt, jacket;
+    body.name = "body";
+    shirt.name = "shirt";
+    jacket.name = "jacket";
+    body.closed = true;
+    body.thickness = shirt.thickness = jacket.thickness = 0.5 * g;
+    body.outer = std::vector<std::string>{"shirt"};
+    shirt.outer = std::vector<std::string>{"jacket"};
+    jacket.outer = std::vector<std::string>{};
+    for (std::size_t i = 0; i < points; ++i)
+        body.points.push_back(at(1.0, s * static_cast<double>(i)));
+    for (double t = 0.5; t <= 5.0 - 4.0 * g + 1e-12; t += s)
+        jacket.points.push_back(at(1.0 + 2.0 * g, t));
+    for (double t = 0.5; t < 5.0; t += s) shirt.points.push_back(at(1.0 + g, t));
+    const int steps = std::max(4, static_cast<int>(std::ceil(pi * g / s)));
+    const Vec2 centre = at(1.0 + 2.0 * g, 5.0), radial = at(1.0, 5.0),
+               along = at(1.0, 5.0 + 0.5 * pi);
+    for (int j = 0; j <= steps; ++j) {  // from radius 1 + g to 1 + 3 g, bulging forward
+        const double a = pi * j / steps;
+        shirt.points.push_back(centre - g * std::cos(a) * radial + g * std::sin(a) * along);
+    }
+    for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * g, t));
+    return Scene({body, shirt, jacket});
+}
+
+// simplify() on `input` at the given settings: clean, the input's sides kept, gaps >= 0.9 x
+// required, every layer on target, Hausdorff <= 2 x `gap`.
+void check_kept(const Scene& input, double gap, const char* decimator, double remove,
+                UntangleSchedule schedule) {
+    const std::vector<int> outside = outside_sides(input);
+    const InputSides sides = record_input_sides(input);
+    SimplifyParams params;
+    params.decimator = decimator;
+    params.remove = remove;
+    params.schedule = schedule;
+    Scene out = input;
+    const SimplifyReport report = simplify(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.targets_met);
+    CheckParams cp;
+    cp.outside_sides = outside;
+    cp.separation_tolerance = params.untangling.separation_tolerance;
+    const InputSides out_sides = sides.renumbered(report.origins);
+    cp.input_sides = &out_sides;
+    const CheckReport check = check_scene(out, cp);
+    CHECK(check.crossing_count == 0);
+    CHECK(check.total_self_crossings() == 0);
+    CHECK(check.nesting_violation_count == 0);
+    CHECK(check.min_separation_ratio >= 0.9);
+    for (std::size_t l = 0; l < out.size(); ++l)
+        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * gap).symmetric() <= 2.0 * gap);
+}
+
+}  // namespace
+
+TEST_CASE("both layers rolled together, and a shirt rolled over a jacket on a body", "[rolled]") {
+    const Scene together = both_rolled(600, 4.0);
+    const Scene shirt = shirt_rolled_over_jacket(600, 4.0);
+    {
+        const CheckReport in = check_scene(together);
+        REQUIRE(in.crossing_count == 0);
+        REQUIRE(in.total_self_crossings() == 0);
+        const CheckReport in2 = check_scene(shirt);
+        REQUIRE(in2.crossing_count == 0);
+        REQUIRE(in2.total_self_crossings() == 0);
+        // The shirt's top lies over the jacket: the global order is broken there.
+        CHECK(record_input_sides(shirt).rolled_count(shirt, outside_sides(shirt)) > 0);
+    }
+    for (const char* decimator : {"visvalingam", "max-error"})
+        for (double remove : {0.9, 0.95})
+            for (UntangleSchedule schedule :
+                 {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+                INFO(decimator << " remove " << remove
+                               << (schedule == UntangleSchedule::Deferred ? " deferred"
+                                                                          : " immediate"));
+                {
+                    INFO("both rolled");
+                    check_kept(together, 4.0 * 10.0 / 599.0, decimator, remove, schedule);
+                }
+                {
+                    INFO("shirt over jacket");
+                    check_kept(shirt, 4.0 * 2.0 * 3.14159265358979323846 / 600.0, decimator, remove,
+                               schedule);
+                }
+            }
+}
+
+TEST_CASE("sides matched by nearest vertex (strata check --reference) judge a simplified roll",
+          "[rolled]") {
+    FamilyParams fp;
+    fp.points = 400;
+    fp.gap = 2.0;
+    const Scene input = make_scene(SceneFamily::Rolled, fp);
+    const double g = rolled_gap(fp);
+    const InputSides recorded = record_input_sides(input);
+    SimplifyParams params;
+    params.remove = 0.9;
+    Scene out = input;
+    const SimplifyReport report = simplify(out, params);
+    REQUIRE(report.collision_free);
+
+    CheckParams cp;
+    cp.outside_sides = outside_sides(input);
+    cp.separation_tolerance = params.untangling.separation_tolerance;
+    // Without the vertex correspondence, as the CLI has it: the same verdict as simplify()'s.
+    const InputSides matched = InputSides::matched(recorded, input, out);
+    cp.input_sides = &matched;
+    CHECK(check_scene(out, cp).nesting_violation_count == 0);
+    // The global order alone calls the roll wrong.
+    cp.input_sides = nullptr;
+    CHECK(check_scene(out, cp).nesting_violation_count > 0);
+
+    // The roll's top pushed under the outer layer, between the two layers (crossing it): the
+    // outer layer's vertices there now lie on the other side of the inner layer's nearest
+    // part than in the reference, which the matched sides find.
+    std::vector<Layer> layers = out.layers();
+    std::size_t moved = 0;
+    for (Vec2& p : layers[0].points)
+        if (p.y > 2.5 * g && p.x < 7.5 && p.x > 5.5) {
+            p.y = 0.5 * g;
+            ++moved;
+        }
+    REQUIRE(moved > 0);
+    const Scene pushed(layers);
+    const InputSides matched_pushed = InputSides::matched(recorded, input, pushed);
+    cp.input_sides = &matched_pushed;
+    CHECK(check_scene(pushed, cp).nesting_violation_count > 0);
+}
