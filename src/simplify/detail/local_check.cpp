@@ -274,31 +274,8 @@ bool LocalCheck::sides_kept(const Overlay& ov) const {
     const Job& job = *ov.job();
     for (std::size_t r = 0; r < job.runs.size(); ++r) {
         const Run& run = job.runs[r];
-        const WorkLayer& w = live_.layer(run.layer);
-        Box2 moved;  // the run's free vertices before and after, and the removed vertex
-        bool any = false;
-        for (std::size_t i = 0; i < run.ids.size(); ++i) {
-            if (!job.pieces[r].is_free[i]) continue;
-            any = true;
-            if (!keeps_sides(run.layer, run.ids[i], ov)) return false;
-            moved.extend(w.pos[run.ids[i]]);
-            moved.extend(ov.pos(run.layer, run.ids[i]));
-        }
-        if (run.layer == job.l) {
-            any = true;
-            moved.extend(job.removed);
-        }
-        if (!any || w.closed) continue;
-        // The other layers' vertices near where this open layer changed.
-        bool ok = true;
-        ov.near(moved.inflated(reach_), [&](std::size_t j, std::size_t u) {
-            if (!ok || j == run.layer) return;
-            const std::size_t v = live_.layer(j).next[u];
-            if (!keeps_sides(j, u, ov, run.layer) ||
-                (v != kNone && !keeps_sides(j, v, ov, run.layer)))
-                ok = false;
-        });
-        if (!ok) return false;
+        for (std::size_t i = 0; i < run.ids.size(); ++i)
+            if (job.pieces[r].is_free[i] && !keeps_sides(run.layer, run.ids[i], ov)) return false;
     }
     return true;
 }
