@@ -195,12 +195,8 @@ class SceneSax {
 
     // Captured values: a stack of the open containers, the outermost first.
     bool open(json container) {
-        if (!capturing()) {
-            capture_.push_back(std::move(container));
-            return true;
-        }
+        if (capturing()) capture_keys_.push_back(capture_key_);  // where it goes in its parent
         capture_.push_back(std::move(container));
-        capture_keys_.push_back(capture_key_);
         return true;
     }
     bool close() {

@@ -358,45 +358,23 @@ bool reaches(const std::vector<std::vector<std::size_t>>& out, std::size_t from,
     return false;
 }
 
-// The vertex coordinates of an ASCII OBJ or OFF file in double precision, in file order;
-// nothing for other formats or anything unexpected (OpenMesh's values are kept then).
+// The vertex coordinates of an ASCII OBJ file in double precision, in file order; nothing for
+// other formats or anything unexpected (OpenMesh's values are kept then).
 std::optional<std::vector<glm::dvec3>> read_ascii_vertices(const std::filesystem::path& path,
                                                            const std::string& ext) {
-    if (ext != ".obj" && ext != ".off") return std::nullopt;
+    if (ext != ".obj") return std::nullopt;
     std::ifstream in(path);
     if (!in) return std::nullopt;
     std::vector<glm::dvec3> out;
-    auto parse3 = [](const std::string& text, glm::dvec3& v) {
-        std::istringstream ls(text);
-        ls.imbue(std::locale::classic());
-        return static_cast<bool>(ls >> v.x >> v.y >> v.z);
-    };
     std::string line;
-    if (ext == ".obj") {
-        while (std::getline(in, line)) {
-            if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-            glm::dvec3 v;
-            if (!parse3(line.substr(2), v)) return std::nullopt;
-            out.push_back(v);
-        }
-        return out;
-    }
-    // OFF: "OFF", then "nv nf ne", then nv times "x y z" (whitespace-separated tokens);
-    // comments start with '#'.
-    std::string text;
-    while (std::getline(in, line)) text += line.substr(0, line.find('#')) + '\n';
-    std::istringstream tokens(text);
-    tokens.imbue(std::locale::classic());
-    std::string magic;
-    std::size_t nv = 0, nf = 0, ne = 0;
-    if (!(tokens >> magic >> nv >> nf >> ne) || magic != "OFF") return std::nullopt;
-    out.reserve(nv);
-    for (std::size_t i = 0; i < nv; ++i) {
+    while (std::getline(in, line)) {
+        if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+        std::istringstream ls(line.substr(2));
+        ls.imbue(std::locale::classic());
         glm::dvec3 v;
-        if (!(tokens >> v.x >> v.y >> v.z)) return std::nullopt;
+        if (!(ls >> v.x >> v.y >> v.z)) return std::nullopt;
         out.push_back(v);
     }
-    if (out.size() != nv) return std::nullopt;
     return out;
 }
 
@@ -447,7 +425,7 @@ std::string shown_token(const std::string& text) {
 }
 
 // A finite coordinate, or an error naming the token.
-void check_coordinate(const std::filesystem::path& path, const TextToken& t) {
+double check_coordinate(const std::filesystem::path& path, const TextToken& t) {
     const char* begin = t.text.c_str();
     char* end = nullptr;
     const double v = std::strtod(begin, &end);
@@ -456,6 +434,7 @@ void check_coordinate(const std::filesystem::path& path, const TextToken& t) {
         mesh_text_error(path, t, "expected a number (got '" + shown_token(t.text) + "')");
     if (!std::isfinite(v))
         mesh_text_error(path, t, "coordinate is not finite (got '" + shown_token(t.text) + "')");
+    return v;
 }
 
 // An integer token, or an error naming it.
@@ -509,32 +488,43 @@ void validate_obj_text(const std::filesystem::path& path, std::istream& in) {
     }
 }
 
-void validate_off_text(const std::filesystem::path& path, std::istream& in) {
+// An OFF file read by strata itself (OpenMesh's OFF reader trusted the counts and face sizes of
+// the file: the fuzzer found a dozen files of under 100 bytes that made it reserve 4 to 45 GB).
+// Plain OFF is read as a stream of tokens; a variant (COFF, NOFF, STOFF, CNOFF ...) one vertex
+// and one face a line, the position being the first three numbers of a vertex line (colours,
+// normals and texture coordinates follow it) and a face's colour what follows its indices.
+struct OffMesh {
+    std::vector<glm::dvec3> vertices;
+    std::vector<std::vector<std::uint32_t>> polygons;
+};
+
+OffMesh read_off_text(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw IoError(path.string() + ": cannot open mesh");
     std::vector<TextToken> tokens;
     std::string line;
     for (std::size_t n = 1; std::getline(in, line); ++n)
         for (auto& t : line_tokens(line.substr(0, line.find('#')), n))
             tokens.push_back(std::move(t));
-    if (tokens.empty()) return;
-    if (tokens[0].text != "OFF") {
-        // A variant (COFF, NOFF, STOFF, 4OFF, nOFF ...): OpenMesh reads the rest. Anything
-        // else is refused: OpenMesh read "OFF\b0..." and "\x01OFF 1 0 0\0..." as OFF and
-        // allocated without bound for a face of -3 vertices (found by fuzz_mesh).
-        static const std::regex variant("(ST)?C?N?4?n?OFF");
-        if (!std::regex_match(tokens[0].text, variant))
-            mesh_text_error(path, tokens[0],
-                            "not an OFF header (got '" + shown_token(tokens[0].text) +
-                                "'; expected OFF, COFF, NOFF, STOFF, 4OFF, nOFF ...)");
-    }
-    // OpenMesh takes the whole first line as the header and reads the counts from the next
-    // one: anything after the magic on its line would be skipped and the counts read from the
-    // wrong place ("OFF 0 0 0" made it reserve 45 GB; found by fuzz_mesh).
-    if (tokens.size() > 1 && tokens[1].line == tokens[0].line)
+    if (tokens.empty()) mesh_text_error(path, {"", 1, 1}, "empty file: expected an OFF header");
+    const std::string& magic = tokens[0].text;
+    static const std::regex variant("(ST)?C?N?4?n?OFF");
+    if (!std::regex_match(magic, variant))
+        mesh_text_error(path, tokens[0],
+                        "not an OFF header (got '" + shown_token(magic) +
+                            "'; expected OFF, COFF, NOFF, STOFF ...)");
+    if (magic.find('4') != std::string::npos || magic.find('n') != std::string::npos)
+        mesh_text_error(path, tokens[0],
+                        "'" + magic + "' (vertices of other than 3 coordinates) is not supported");
+    if (tokens.size() > 1 && tokens[1].line == tokens[0].line) {
+        if (tokens[1].text == "BINARY")
+            mesh_text_error(path, tokens[1],
+                            "binary OFF is not supported (write it as ASCII OFF, OBJ or PLY)");
         mesh_text_error(path, tokens[1],
-                        "the OFF header line must hold only '" + tokens[0].text +
+                        "the OFF header line must hold only '" + magic +
                             "' (the counts go on the next line; got '" +
                             shown_token(tokens[1].text) + "')");
-    const bool plain = tokens[0].text == "OFF";
+    }
     std::size_t next = 1;
     auto take = [&](const char* what) -> const TextToken& {
         if (next >= tokens.size()) {
@@ -544,59 +534,57 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
         }
         return tokens[next++];
     };
-    if (tokens[0].text.find('n') != std::string::npos) {
-        const TextToken& t = take("the dimension of an nOFF file");
-        integer_token(path, t, t.text, "a dimension");
-    }
-    if (next < tokens.size() && tokens[next].text == "BINARY")
-        mesh_text_error(path, tokens[next],
-                        "binary OFF is not supported (write it as ASCII OFF, OBJ or PLY)");
     long long counts[3] = {0, 0, 0};
     for (long long& c : counts) {
         const TextToken& t = take("the vertex, face and edge counts");
         c = integer_token(path, t, t.text, "a count");
         if (c < 0) mesh_text_error(path, t, "count is negative (got '" + t.text + "')");
     }
-    if (!plain) {
-        // A variant's vertex lines carry colours, normals or texture coordinates (nOFF: any
-        // number of coordinates), so only a bound is checked here: every vertex and every face
-        // takes at least one token. OpenMesh would otherwise reserve and loop over any count
-        // (a 70-byte NOFF file claiming 2e8 faces took 11 GB; found by fuzz_mesh).
-        const auto left = static_cast<long long>(tokens.size() - next);
-        for (int k = 0; k < 2; ++k)
-            if (counts[k] > left) {
-                const TextToken& at = tokens[next - 3 + static_cast<std::size_t>(k)];
-                mesh_text_error(path, at,
-                                "count " + at.text + " is more than the file holds (" +
-                                    std::to_string(left) + " values follow the counts)");
-            }
-        // Faces: skip one line per vertex, then a face's size (its line's first token) is
-        // bounded the same way: OpenMesh sizes a face's index list from it.
-        std::size_t at = next;
-        for (long long v = 0; v < counts[0] && at < tokens.size(); ++v) {
-            const std::size_t line_number = tokens[at].line;
-            while (at < tokens.size() && tokens[at].line == line_number) ++at;
+    // Every vertex and face takes at least one value: a count larger than what is left is
+    // refused before anything is reserved.
+    const auto left = static_cast<long long>(tokens.size() - next);
+    for (int k = 0; k < 2; ++k)
+        if (counts[k] > left) {
+            const TextToken& at = tokens[next - 3 + static_cast<std::size_t>(k)];
+            mesh_text_error(path, at,
+                            "count " + at.text + " is more than the file holds (" +
+                                std::to_string(left) + " values follow the counts)");
         }
-        for (long long f = 0; f < counts[1] && at < tokens.size(); ++f) {
-            const TextToken& t = tokens[at];
-            char* end = nullptr;
-            const long long size = std::strtoll(t.text.c_str(), &end, 10);
-            if (*end == '\0' && size > static_cast<long long>(tokens.size() - at))
-                mesh_text_error(path, t,
-                                "face size " + t.text + " is more than the file holds (" +
-                                    std::to_string(tokens.size() - at - 1) + " values follow)");
-            const std::size_t line_number = t.line;
-            while (at < tokens.size() && tokens[at].line == line_number) ++at;
-        }
-        return;
+    const bool plain = magic == "OFF";
+    OffMesh out;
+    out.vertices.reserve(static_cast<std::size_t>(counts[0]));
+    out.polygons.reserve(static_cast<std::size_t>(counts[1]));
+    // The tokens of the line that starts at `next` (a variant's vertex or face line).
+    auto line_end = [&] {
+        std::size_t end = next;
+        while (end < tokens.size() && tokens[end].line == tokens[next].line) ++end;
+        return end;
+    };
+    for (long long v = 0; v < counts[0]; ++v) {
+        const std::size_t end = plain || next >= tokens.size() ? 0 : line_end();
+        if (!plain && next < tokens.size() && end - next < 3)
+            mesh_text_error(path, tokens[next], "a vertex line needs 3 coordinates");
+        glm::dvec3 p;
+        for (int k = 0; k < 3; ++k) p[k] = check_coordinate(path, take("a vertex coordinate"));
+        if (!plain) next = end;  // colour, normal, texture coordinates
+        out.vertices.push_back(p);
     }
-    for (long long v = 0; v < counts[0]; ++v)
-        for (int k = 0; k < 3; ++k) check_coordinate(path, take("a vertex coordinate"));
     for (long long f = 0; f < counts[1]; ++f) {
         const TextToken& ct = take("a face");
+        const std::size_t face_line = ct.line;
         const long long size = integer_token(path, ct, ct.text, "a face size");
         if (size < 0) mesh_text_error(path, ct, "face size is negative (got '" + ct.text + "')");
-        const std::size_t face_line = ct.line;
+        std::size_t on_line = 0;
+        for (std::size_t k = next; k < tokens.size() && tokens[k].line == face_line; ++k) ++on_line;
+        if ((plain && size > static_cast<long long>(tokens.size() - next)) ||
+            (!plain && size > static_cast<long long>(on_line)))
+            mesh_text_error(path, ct,
+                            "face size " + ct.text + " is more than the " +
+                                (plain ? "file" : "line") + " holds (" +
+                                std::to_string(plain ? tokens.size() - next : on_line) +
+                                " values follow)");
+        std::vector<std::uint32_t> polygon;
+        polygon.reserve(static_cast<std::size_t>(size));
         for (long long k = 0; k < size; ++k) {
             const TextToken& t = take("a face vertex index");
             const long long i = integer_token(path, t, t.text, "a vertex index");
@@ -605,9 +593,12 @@ void validate_off_text(const std::filesystem::path& path, std::istream& in) {
                                 "face names vertex " + std::to_string(i) +
                                     ", which does not exist (" + std::to_string(counts[0]) +
                                     " vertices)");
+            polygon.push_back(static_cast<std::uint32_t>(i));
         }
         while (next < tokens.size() && tokens[next].line == face_line) ++next;  // face colour
+        out.polygons.push_back(std::move(polygon));
     }
+    return out;
 }
 
 void validate_stl_text(const std::filesystem::path& path, std::istream& in) {
@@ -643,7 +634,7 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
     };
     std::string line;
     std::size_t n = 0;
-    bool format = false;
+    bool format = false, element = false;
     while (std::getline(in, line)) {
         ++n;
         const auto tokens = line_tokens(line, n);
@@ -666,10 +657,15 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
                 tokens[1].text != "binary_big_endian")
                 mesh_text_error(path, tokens[1],
                                 "unknown PLY format '" + shown_token(tokens[1].text) + "'");
-            check_coordinate(path, tokens[2]);
+            // The only PLY version (OpenMesh allocated 2 GB on "ascii 333...1").
+            if (check_coordinate(path, tokens[2]) != 1.0)
+                mesh_text_error(
+                    path, tokens[2],
+                    "unsupported PLY version '" + shown_token(tokens[2].text) + "' (expected 1.0)");
             format = true;
         } else if (key == "element") {
             expect_count(tokens, 3, "element NAME COUNT");
+            element = true;
             const long long count =
                 integer_token(path, tokens[2], tokens[2].text, "an element count");
             if (count < 0)
@@ -681,6 +677,8 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
                                 "count " + tokens[2].text + " is more than the file holds (" +
                                     std::to_string(file_size) + " bytes)");
         } else if (key == "property") {
+            // OpenMesh dereferences the current element (found by fuzz_mesh: a SEGV).
+            if (!element) mesh_text_error(path, tokens[0], "a property before any element line");
             if (tokens.size() >= 2 && tokens[1].text == "list") {
                 expect_count(tokens, 5, "property list COUNT_TYPE TYPE NAME");
                 check_type(tokens[2]);
@@ -704,8 +702,6 @@ void validate_mesh_text(const std::filesystem::path& path, const std::string& ex
     if (!in) return;
     if (ext == ".obj")
         validate_obj_text(path, in);
-    else if (ext == ".off")
-        validate_off_text(path, in);
     else if (ext == ".stl")
         validate_stl_text(path, in);
     else if (ext == ".ply")
@@ -853,6 +849,17 @@ SliceMesh read_slice_mesh(const std::filesystem::path& path, const std::string& 
     if (!std::filesystem::is_regular_file(path, ec))
         throw IoError(path.string() + ": cannot open mesh (no such file)");
 
+    if (ext == ".off") {
+        OffMesh off = read_off_text(path);
+        const std::size_t faces = off.polygons.size(), count = off.vertices.size();
+        SliceMesh mesh = make_slice_mesh(name.empty() ? path.stem().string() : name,
+                                         std::move(off.vertices), off.polygons);
+        if (mesh.triangles.empty()) throw InvalidInput(path.string() + ": the mesh has no faces");
+        mesh.read_report.file_vertices = count;
+        mesh.read_report.file_faces = faces;
+        mesh.read_report.double_precision = true;
+        return mesh;
+    }
     validate_mesh_text(path, ext);
     OmMesh om;
     om.request_face_status();

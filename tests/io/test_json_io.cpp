@@ -43,6 +43,26 @@ TEST_CASE("the documented example parses with every field", "[io][json]") {
                Contains("\"producer\"") && Contains("\"colour\""));
 }
 
+TEST_CASE("unknown keys keep their nested values, and a duplicate key keeps the last value",
+          "[io][json]") {
+    // Read without a document tree; unknown values are captured into one each.
+    const Scene scene = parse_scene_json(R"({"strata": 1,
+        "meta": {"z": [1, {"b": [2.5, -3, true]}, "s"], "a": null, "e": {}, "f": []},
+        "layers": [{"points": [[0, 0], [1, 0]], "x": [[1], [2, {"k": "v"}]], "n": 7}]})");
+    CHECK(scene.metadata.at("meta") ==
+          R"({"a":null,"e":{},"f":[],"z":[1,{"b":[2.5,-3,true]},"s"]})");
+    CHECK(scene.layer(0).extra.at("x") == R"([[1],[2,{"k":"v"}]])");
+    CHECK(scene.layer(0).extra.at("n") == "7");
+    CHECK(scene.layer(0).name == "layer_0");
+    // Duplicate keys: the document-tree reader decides (the last value wins), as before.
+    const Scene twice = parse_scene_json(R"({"layers": [{"points": [[0, 0], [1, 0]]}],
+        "layers": [{"name": "b", "points": [[0, 1], [2, 1], [3, 1]], "points": [[5, 5], [6, 6]]}]})");
+    REQUIRE(twice.size() == 1);
+    CHECK(twice.layer(0).name == "b");
+    REQUIRE(twice.layer(0).points.size() == 2);
+    CHECK(twice.layer(0).points[1] == Vec2(6.0, 6.0));
+}
+
 TEST_CASE("JSON round trips are exact", "[io][json]") {
     SECTION("generated scenes") {
         for (const Scene& scene : {test::nested_circles(3, 37, 1.0 / 3.0, 0.1, 0.01),

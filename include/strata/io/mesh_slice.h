@@ -82,9 +82,11 @@ struct SliceMesh {
 SliceMesh make_slice_mesh(std::string name, std::vector<glm::dvec3> vertices,
                           const std::vector<std::vector<std::uint32_t>>& polygons);
 
-/// Reads an OBJ, OFF, PLY or STL file through OpenMesh (double precision) and makes a
-/// SliceMesh of it (see make_slice_mesh()). `name` defaults to the file stem. OpenMesh's
-/// messages are captured into read_report.messages; nothing is printed.
+/// Reads an OBJ, PLY or STL file through OpenMesh, or an ASCII OFF file (OFF, COFF, NOFF,
+/// STOFF ...: the first three numbers of a vertex line are its position) with strata's own
+/// reader, in double precision, and makes a SliceMesh of it (see make_slice_mesh()). `name`
+/// defaults to the file stem. OpenMesh's messages are captured into read_report.messages;
+/// nothing is printed.
 /// @throws IoError the file is missing or OpenMesh cannot read it (with its message).
 /// @throws InvalidInput an unsupported extension, or a mesh without faces.
 SliceMesh read_slice_mesh(const std::filesystem::path& path, const std::string& name = {});
