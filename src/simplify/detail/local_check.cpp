@@ -254,11 +254,10 @@ int LocalCheck::side_against(std::size_t k, const Vec2& p, const Overlay& ov) co
     return segment_side(a, b, p);
 }
 
-bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
-                             std::size_t only) const {
+bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov) const {
     const Vec2 p = ov.pos(j, x);
     for (std::size_t k = 0; k < live_.size(); ++k) {
-        if (k == j || live_.layer(k).closed || (only != kNone && k != only)) continue;
+        if (k == j || live_.layer(k).closed) continue;
         const Relation r = input_.relation(j, k);
         if (r != Relation::Under && r != Relation::Over) continue;
         int wanted = sides_.side(j, x, k);

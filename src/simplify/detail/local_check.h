@@ -50,9 +50,8 @@ class LocalCheck {
     /// closer than reach_, closest to an end, or on the layer).
     int side_against(std::size_t k, const Vec2& p, const Overlay& ov) const;
     /// Vertex x of layer j, at its overlay position, is on its wanted side of every open layer
-    /// k it nests with (or of `only` when given).
-    bool keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
-                     std::size_t only = static_cast<std::size_t>(-1)) const;
+    /// k it nests with.
+    bool keeps_sides(std::size_t j, std::size_t x, const Overlay& ov) const;
     bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
                         const Vec2& w) const;
     bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
