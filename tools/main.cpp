@@ -46,9 +46,9 @@ int main(int argc, char** argv) {
         std::cerr << "strata: error: " << e.what() << '\n';
         return 1;
     } catch (const std::bad_alloc&) {
-        // Outputs are written atomically at the end of a run, so none was.
+        // Outputs are written atomically (a batch writes each slice's when it is done).
         std::cerr << "strata: error: out of memory: the input needs more memory than this "
-                     "process may use (machine or ulimit); nothing written\n";
+                     "process may use (machine or ulimit); no partial output written\n";
         return 1;
     } catch (const std::exception& e) {
         std::cerr << "strata: error: internal: " << e.what() << '\n';
