@@ -170,6 +170,34 @@ Scene wavy_roll(std::size_t points, double gap_in_segments) {
     return Scene({inner, outer});
 }
 
+// simplify() on `input` at the given settings: clean, the input's sides kept, gaps >= 0.9 x
+// required, every layer on target, Hausdorff <= 2 x `gap`.
+void check_kept(const Scene& input, double gap, const char* decimator, double remove,
+                UntangleSchedule schedule) {
+    const std::vector<int> outside = outside_sides(input);
+    const InputSides sides = record_input_sides(input);
+    SimplifyParams params;
+    params.decimator = decimator;
+    params.remove = remove;
+    params.schedule = schedule;
+    Scene out = input;
+    const SimplifyReport report = simplify(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.targets_met);
+    CheckParams cp;
+    cp.outside_sides = outside;
+    cp.separation_tolerance = params.untangling.separation_tolerance;
+    const InputSides out_sides = sides.renumbered(report.origins);
+    cp.input_sides = &out_sides;
+    const CheckReport check = check_scene(out, cp);
+    CHECK(check.crossing_count == 0);
+    CHECK(check.total_self_crossings() == 0);
+    CHECK(check.nesting_violation_count == 0);
+    CHECK(check.min_separation_ratio >= 0.9);
+    for (std::size_t l = 0; l < out.size(); ++l)
+        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * gap).symmetric() <= 2.0 * gap);
+}
+
 }  // namespace
 
 TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
@@ -186,26 +214,7 @@ TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
                     INFO("gap " << gap << " " << decimator << " remove " << remove
                                 << (schedule == UntangleSchedule::Deferred ? " deferred"
                                                                            : " immediate"));
-                    SimplifyParams params;
-                    params.decimator = decimator;
-                    params.remove = remove;
-                    params.schedule = schedule;
-                    Scene out = input;
-                    const SimplifyReport report = simplify(out, params);
-                    CHECK(report.collision_free);
-                    CHECK(report.targets_met);
-                    CheckParams cp;
-                    cp.outside_sides = outside;
-                    cp.separation_tolerance = params.untangling.separation_tolerance;
-                    const InputSides out_sides = sides.renumbered(report.origins);
-                    cp.input_sides = &out_sides;
-                    const CheckReport check = check_scene(out, cp);
-                    CHECK(check.crossing_count == 0);
-                    CHECK(check.nesting_violation_count == 0);
-                    CHECK(check.min_separation_ratio >= 0.9);
-                    for (std::size_t l = 0; l < out.size(); ++l)
-                        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * g).symmetric() <=
-                              2.0 * g);
+                    check_kept(input, g, decimator, remove, schedule);
                 }
     }
 }
@@ -270,34 +279,6 @@ Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments) {
     }
     for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * g, t));
     return Scene({body, shirt, jacket});
-}
-
-// simplify() on `input` at the given settings: clean, the input's sides kept, gaps >= 0.9 x
-// required, every layer on target, Hausdorff <= 2 x `gap`.
-void check_kept(const Scene& input, double gap, const char* decimator, double remove,
-                UntangleSchedule schedule) {
-    const std::vector<int> outside = outside_sides(input);
-    const InputSides sides = record_input_sides(input);
-    SimplifyParams params;
-    params.decimator = decimator;
-    params.remove = remove;
-    params.schedule = schedule;
-    Scene out = input;
-    const SimplifyReport report = simplify(out, params);
-    CHECK(report.collision_free);
-    CHECK(report.targets_met);
-    CheckParams cp;
-    cp.outside_sides = outside;
-    cp.separation_tolerance = params.untangling.separation_tolerance;
-    const InputSides out_sides = sides.renumbered(report.origins);
-    cp.input_sides = &out_sides;
-    const CheckReport check = check_scene(out, cp);
-    CHECK(check.crossing_count == 0);
-    CHECK(check.total_self_crossings() == 0);
-    CHECK(check.nesting_violation_count == 0);
-    CHECK(check.min_separation_ratio >= 0.9);
-    for (std::size_t l = 0; l < out.size(); ++l)
-        CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * gap).symmetric() <= 2.0 * gap);
 }
 
 }  // namespace
