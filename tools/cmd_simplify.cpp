@@ -63,8 +63,8 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             r.raised_separations);
     if (r.rolled_vertices > 0)
         std::printf(
-            "local sides: %zu input vertices lie on the other side of an open layer than the "
-            "global order (rolled or folded over) and keep it\n",
+            "local sides: %zu output vertices lie on the other side of an open layer than the "
+            "global order (rolled or folded over), as in the input\n",
             r.rolled_vertices);
     if (!r.collision_free)
         std::fprintf(

@@ -16,9 +16,12 @@
 #include <boost/geometry/strategies/strategies.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <tuple>
 #include <utility>
@@ -816,41 +819,92 @@ CheckReport check_scene(const Scene& scene, const CheckParams& params) {
 
 // Defined here, next to the nearest queries and the side rule that check_scene() uses, so
 // that the recorded sides and the checked ones are decided by the same code.
+struct InputSides::Recorded {
+    static constexpr signed char kUnknown = 3;  // not found yet
+
+    Scene scene;
+    double reach = 0.0;
+    std::size_t n = 0;
+    // memo[a * n + b][k]: the code of vertex k of layer a against open layer b (kUnknown
+    // until asked for); null where nothing is recorded (b closed, side by side, out of reach).
+    std::vector<std::unique_ptr<std::atomic<signed char>[]>> memo;
+    // The segment index of each open layer, built when first needed.
+    mutable std::vector<std::unique_ptr<SegmentIndex>> indices;
+    std::unique_ptr<std::once_flag[]> built;
+
+    const SegmentIndex& index(std::size_t b) const {
+        std::call_once(built[b],
+                       [&] { indices[b] = std::make_unique<SegmentIndex>(scene.layer(b)); });
+        return *indices[b];
+    }
+
+    int code(std::size_t a, std::size_t k, std::size_t b) const {
+        const std::unique_ptr<std::atomic<signed char>[]>& found = memo[a * n + b];
+        const std::vector<Vec2>& points = scene.layer(a).points;
+        if (!found || k >= points.size()) return 0;
+        signed char c = found[k].load(std::memory_order_relaxed);
+        if (c != kUnknown) return c;
+        // Threads that ask at once find the same value.
+        const SegmentIndex& other = index(b);
+        const Nearest nr = nearest_on(other, points[k], reach);
+        const int side = side_of(other, points[k], nr);
+        // Found, not on b, and no side: closest to an end point of b.
+        c = side == 0 && nr.found() && nr.distance > 0.0 ? InputSides::kBeyondEnd
+                                                         : static_cast<signed char>(side);
+        found[k].store(c, std::memory_order_relaxed);
+        return c;
+    }
+};
+
 InputSides record_input_sides(const Scene& scene, const InputSideParams& params) {
     validate(params);
-    const double reach = params.reach > 0.0 ? params.reach : kSideReach * automatic_near(scene);
+    auto r = std::make_shared<InputSides::Recorded>();
+    r->scene = scene;
+    r->reach = params.reach > 0.0 ? params.reach : kSideReach * automatic_near(scene);
     const std::size_t n = scene.size();
-    InputSides out;
-    out.n_ = n;
-    out.sides_.assign(n * n, {});
-    std::vector<SegmentIndex> indices(n);
+    r->n = n;
+    r->memo.resize(n * n);
+    r->indices.resize(n);
+    r->built = std::make_unique<std::once_flag[]>(n);
     std::vector<Box2> bounds;
     for (std::size_t i = 0; i < n; ++i) bounds.push_back(scene.layer(i).bounds());
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t b) {
-        if (!scene.layer(b).closed) indices[b] = SegmentIndex(scene.layer(b));
-    });
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
     for (std::size_t a = 0; a < n; ++a)
         for (std::size_t b = 0; b < n; ++b) {
-            const Relation r = a == b ? Relation::Same : scene.relation(a, b);
-            if (scene.layer(b).closed || (r != Relation::Under && r != Relation::Over)) continue;
-            if (bounds[a].overlaps(bounds[b].inflated(reach))) pairs.emplace_back(a, b);
+            const Relation rel = a == b ? Relation::Same : scene.relation(a, b);
+            if (scene.layer(b).closed || (rel != Relation::Under && rel != Relation::Over) ||
+                !bounds[a].overlaps(bounds[b].inflated(r->reach)))
+                continue;
+            const std::size_t count = scene.layer(a).points.size();
+            auto& found = r->memo[a * n + b];
+            found = std::make_unique<std::atomic<signed char>[]>(count);
+            for (std::size_t k = 0; k < count; ++k)
+                found[k].store(InputSides::Recorded::kUnknown, std::memory_order_relaxed);
         }
-    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t t) {
-        const auto [a, b] = pairs[t];
-        const std::vector<Vec2>& points = scene.layer(a).points;
-        std::vector<signed char>& sides = out.sides_[a * n + b];
-        sides.assign(points.size(), 0);
-        for (std::size_t k = 0; k < points.size(); ++k) {
-            const Nearest nr = nearest_on(indices[b], points[k], reach);
-            const int side = side_of(indices[b], points[k], nr);
-            // Found, not on b, and no side: closest to an end point of b.
-            sides[k] = side == 0 && nr.found() && nr.distance > 0.0
-                           ? InputSides::kBeyondEnd
-                           : static_cast<signed char>(side);
-        }
-    });
+    InputSides out;
+    out.n_ = n;
+    out.recorded_ = std::move(r);
     return out;
+}
+
+int InputSides::code(std::size_t a, std::size_t k, std::size_t b) const {
+    if (a >= n_ || b >= n_ || !recorded_) return 0;
+    if (!origin_.empty()) {
+        if (k >= origin_[a].size()) return 0;
+        k = origin_[a][k];
+    }
+    if (!layer_.empty()) {
+        a = layer_[a];
+        b = layer_[b];
+        if (a == kNoLayer || b == kNoLayer) return 0;
+    }
+    return recorded_->code(a, k, b);
+}
+
+std::size_t InputSides::vertex_count(std::size_t a) const {
+    if (a >= n_ || !recorded_) return 0;
+    if (!origin_.empty()) return origin_[a].size();
+    const std::size_t r = layer_.empty() ? a : layer_[a];
+    return r == kNoLayer ? 0 : recorded_->scene.layer(r).points.size();
 }
 
 InputSides InputSides::matched(const InputSides& recorded, const Scene& reference,
@@ -859,16 +913,19 @@ InputSides InputSides::matched(const InputSides& recorded, const Scene& referenc
     if (recorded.empty()) return out;
     const std::size_t n = scene.size();
     out.n_ = n;
-    out.sides_.assign(n * n, {});
-    std::vector<std::optional<std::size_t>> namesake(n);
-    for (std::size_t i = 0; i < n; ++i) namesake[i] = reference.find(scene.layer(i).name);
+    out.recorded_ = recorded.recorded_;
+    out.layer_.assign(n, kNoLayer);
+    out.origin_.assign(n, {});
     for (std::size_t a = 0; a < n; ++a) {
-        if (!namesake[a] || *namesake[a] >= recorded.n_) continue;
-        const std::size_t ra = *namesake[a];
+        const std::optional<std::size_t> namesake = reference.find(scene.layer(a).name);
+        if (!namesake || *namesake >= recorded.n_) continue;
+        const std::size_t ra = *namesake;
+        out.layer_[a] = recorded.layer_.empty() ? ra : recorded.layer_[ra];
+        if (out.layer_[a] == kNoLayer) continue;
         const Layer& ref_layer = reference.layer(ra);
         const SegmentIndex index(ref_layer);
         // The reference vertex of each vertex of layer a: the nearer end of its closest segment.
-        std::vector<std::size_t> origin;
+        std::vector<std::size_t>& origin = out.origin_[a];
         for (const Vec2& p : scene.layer(a).points) {
             const Nearest nr = nearest_on(index, p);
             std::size_t k = 0;
@@ -878,14 +935,9 @@ InputSides InputSides::matched(const InputSides& recorded, const Scene& referenc
                                    std::hypot(nr.point.x - s1.x, nr.point.y - s1.y);
                 k = first ? nr.segment : (nr.segment + 1) % ref_layer.points.size();
             }
+            if (!recorded.origin_.empty())
+                k = k < recorded.origin_[ra].size() ? recorded.origin_[ra][k] : kNoLayer;
             origin.push_back(k);
-        }
-        for (std::size_t b = 0; b < n; ++b) {
-            if (!namesake[b] || *namesake[b] >= recorded.n_) continue;
-            const std::vector<signed char>& from = recorded.sides_[ra * recorded.n_ + *namesake[b]];
-            if (from.empty()) continue;
-            std::vector<signed char>& to = out.sides_[a * n + b];
-            for (std::size_t k : origin) to.push_back(k < from.size() ? from[k] : 0);
         }
     }
     return out;

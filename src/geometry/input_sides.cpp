@@ -4,6 +4,7 @@
 #include "strata/core/format.h"
 #include "strata/geometry/predicates.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -22,23 +23,20 @@ InputSides InputSides::renumbered(const std::vector<std::vector<std::size_t>>& o
     if (origin.size() != n_)
         throw InvalidInput("input sides: renumbered() got " + std::to_string(origin.size()) +
                            " layers for " + std::to_string(n_));
-    InputSides out;
-    out.n_ = n_;
-    out.sides_.assign(n_ * n_, {});
-    for (std::size_t a = 0; a < n_; ++a)
-        for (std::size_t b = 0; b < n_; ++b) {
-            const std::vector<signed char>& from = sides_[a * n_ + b];
-            if (from.empty()) continue;
-            std::vector<signed char>& to = out.sides_[a * n_ + b];
-            to.reserve(origin[a].size());
-            for (std::size_t k : origin[a]) {
-                if (k >= from.size())
-                    throw InvalidInput("input sides: renumbered(): vertex " + std::to_string(k) +
-                                       " of layer " + std::to_string(a) + " out of range (" +
-                                       std::to_string(from.size()) + " vertices)");
-                to.push_back(from[k]);
-            }
+    InputSides out = *this;
+    out.origin_.assign(n_, {});
+    for (std::size_t a = 0; a < n_; ++a) {
+        const std::size_t count = vertex_count(a);
+        std::vector<std::size_t>& to = out.origin_[a];
+        to.reserve(origin[a].size());
+        for (std::size_t k : origin[a]) {
+            if (k >= count)
+                throw InvalidInput("input sides: renumbered(): vertex " + std::to_string(k) +
+                                   " of layer " + std::to_string(a) + " out of range (" +
+                                   std::to_string(count) + " vertices)");
+            to.push_back(origin_.empty() ? k : origin_[a][k]);
         }
+    }
     return out;
 }
 
@@ -49,8 +47,11 @@ std::size_t InputSides::rolled_count(const Scene& scene,
         for (std::size_t b = 0; b < n_ && b < outside_sides.size(); ++b) {
             if (a == b) continue;
             const int wanted = global_side(scene.relation(a, b), outside_sides[b]);
-            for (signed char s : sides_[a * n_ + b])
-                if (s != 0 && s != kBeyondEnd && s != wanted) ++count;
+            const std::size_t vertices = std::min(vertex_count(a), scene.layer(a).points.size());
+            for (std::size_t k = 0; k < vertices; ++k) {
+                const int s = side(a, k, b);
+                if (s != 0 && s != wanted) ++count;
+            }
         }
     return count;
 }

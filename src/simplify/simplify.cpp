@@ -100,9 +100,9 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     if (outside_signs.empty())
         for (std::size_t l = 0; l < input.size(); ++l)
             outside_signs.push_back(outside_side(input, l));
-    const auto sides_start = Clock::now();
+    // Found when asked for: by the local checks and the untanglings for the vertices they
+    // move, by the final check for the vertices kept.
     const InputSides input_sides = record_input_sides(input);
-    const double seconds_sides = seconds_since(sides_start);
     const detail::LocalCheck check(input, live, separations, outside_signs, input_sides);
     detail::JobRunner jobs(input, params, settings, live, separations, check, input_sides);
     detail::Scheduler scheduler(params, live, separations, check, jobs);
@@ -120,8 +120,8 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     // local sides too: a nesting violation is a vertex that changed side.
     check_params.outside_sides = outside_signs;
     report.origins = live.origins();
-    report.rolled_vertices = input_sides.rolled_count(input, outside_signs);
     const InputSides output_sides = input_sides.renumbered(report.origins);
+    report.rolled_vertices = output_sides.rolled_count(out, outside_signs);
     check_params.input_sides = &output_sides;
     const CheckReport check_report = check_scene(out, check_params);
     report.crossings = check_report.crossing_count;
@@ -145,7 +145,7 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t l) {
         report.layers[l].hausdorff = hausdorff(out.layer(l), scene.layer(l), tolerance).symmetric();
     });
-    report.seconds_check += seconds_since(start) + seconds_sides;  // the sides: a check's part
+    report.seconds_check += seconds_since(start);
     scene = std::move(out);
     return report;
 }

@@ -9,6 +9,7 @@
 #include "strata/geometry/scene.h"
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace strata {
@@ -31,6 +32,10 @@ void validate(const InputSideParams& params);
 /// The recorded sides. side(a, k, b) is the side of open layer b that vertex k of layer a lies
 /// on: +1 right of b's direction of travel, -1 left, 0 nothing recorded (b closed, a and b side
 /// by side, farther than the reach, closest to an end point of b, or on b).
+///
+/// Sides are found when first asked for (one nearest query in the recorded scene, then kept):
+/// a simplification asks only for the vertices it moves and the ones it keeps, a few percent
+/// of the input. Copies share what was found. Safe to query from several threads at once.
 class InputSides {
   public:
     InputSides() = default;
@@ -49,7 +54,7 @@ class InputSides {
         return code(a, k, b) == kBeyondEnd;
     }
     /// The same sides for a scene with the same layers whose vertex k of layer a is vertex
-    /// origin[a][k] of the recorded one (a simplification keeps vertices and their order).
+    /// origin[a][k] of this one (a simplification keeps vertices and their order).
     /// @throws InvalidInput when origin has the wrong layer count or an index out of range.
     InputSides renumbered(const std::vector<std::vector<std::size_t>>& origin) const;
     /// The sides for `scene`, whose layers are those of `reference` (the scene these sides were
@@ -60,24 +65,33 @@ class InputSides {
     static InputSides matched(const InputSides& recorded, const Scene& reference,
                               const Scene& scene);
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
-    /// outside_side() per layer): the rolled or folded-over vertices, once per other layer.
+    /// outside_side() per layer of `scene`, the scene these sides are for): the rolled or
+    /// folded-over vertices, once per other layer. Finds the side of every vertex.
     std::size_t rolled_count(const Scene& scene, const std::vector<int>& outside_sides) const;
 
   private:
     static constexpr signed char kBeyondEnd = 2;
-    int code(std::size_t a, std::size_t k, std::size_t b) const {
-        if (a >= n_ || b >= n_) return 0;
-        const std::vector<signed char>& s = sides_[a * n_ + b];
-        return k < s.size() ? s[k] : 0;
-    }
+    /// The recorded scene, its segment indices and the sides found so far (checks.cpp).
+    struct Recorded;
+    /// The side code of vertex k of layer a against layer b (0, +-1 or kBeyondEnd).
+    int code(std::size_t a, std::size_t k, std::size_t b) const;
+    /// Vertices of layer a of the scene these sides are for.
+    std::size_t vertex_count(std::size_t a) const;
     friend InputSides record_input_sides(const Scene&, const InputSideParams&);
+
+    static constexpr std::size_t kNoLayer = static_cast<std::size_t>(-1);
     std::size_t n_ = 0;
-    std::vector<std::vector<signed char>> sides_;  // [a * n + b][k]
+    std::shared_ptr<const Recorded> recorded_;
+    /// Layer of this view -> recorded layer (kNoLayer: none); empty: the same layers.
+    std::vector<std::size_t> layer_;
+    /// Per layer of this view, the recorded vertex of each vertex; empty: the same vertices.
+    std::vector<std::vector<std::size_t>> origin_;
 };
 
 /// @brief Records the side of every vertex of `scene` against every open layer under or over
 /// its own layer within params.reach, with the rule check_scene() uses (the side at the
-/// closest point; at a corner, the side of the corner's wedge).
+/// closest point; at a corner, the side of the corner's wedge). Keeps a copy of `scene`; each
+/// side is found when first asked for (see InputSides).
 /// @throws InvalidInput bad params.
 InputSides record_input_sides(const Scene& scene, const InputSideParams& params = {});
 

@@ -115,10 +115,10 @@ struct SimplifyReport {
     std::size_t crossings = 0, self_crossings = 0, nesting_violations = 0;
     double min_separation_ratio = 0.0;  ///< +inf when nothing is required.
     bool collision_free = false;
-    /// Vertices of the input lying on the side of an open layer that the global order does
-    /// not give them (rolled or folded-over parts; once per other layer), whose side the
-    /// simplification keeps (strata/geometry/input_sides.h). The nesting violations above
-    /// are vertices that changed side relative to the input.
+    /// Vertices of the output that lie, as they did in the input, on the side of an open
+    /// layer that the global order does not give them (rolled or folded-over parts; once per
+    /// other layer): the simplification keeps the input's sides (strata/geometry/input_sides.h).
+    /// The nesting violations above are vertices that changed side relative to the input.
     std::size_t rolled_vertices = 0;
     /// Per layer, the input index of every output vertex, in output order (a simplification
     /// keeps vertices and their order; InputSides::renumbered() takes it).
