@@ -211,58 +211,77 @@ bool LocalCheck::nesting_kept(std::size_t l, const std::vector<std::size_t>& ids
     return true;
 }
 
-int LocalCheck::side_against(std::size_t k, const Vec2& p, const Overlay& ov) const {
-    const WorkLayer& w = live_.layer(k);
+void LocalCheck::sides_against(const Vec2& p, const Overlay& ov,
+                               std::vector<Closest>& closest) const {
     Box2 box;
     box.extend(p);
-    double best = reach_;
-    std::size_t seg = kNone;
-    Vec2 closest{0.0};
+    std::size_t open = 0;  // layers still looking
+    for (const Closest& c : closest) open += c.wanted && !c.settled;
     // Boxes growing from the largest separation to reach_: every segment closer than r meets
-    // the box inflated by r, so a closest one found within r is the closest.
-    for (double r = std::min(reach_, std::max(separations_.max_reach, 1e-3 * reach_));;
+    // the box inflated by r, so a closest one found within r is the closest. One box query
+    // serves every layer still looking.
+    for (double r = std::min(reach_, std::max(separations_.max_reach, 1e-3 * reach_)); open > 0;
          r = std::min(reach_, 2.0 * r)) {
-        best = reach_;
-        seg = kNone;
-        ov.near(box.inflated(r), [&](std::size_t j, std::size_t u) {
-            if (j != k) return;
-            const Vec2 a = ov.pos(k, u), b = ov.pos(k, w.next[u]);
+        for (Closest& c : closest)
+            if (c.wanted && !c.settled) {
+                c.best = reach_;
+                c.seg = kNone;
+            }
+        ov.near(box.inflated(r), [&](std::size_t k, std::size_t u) {
+            Closest& c = closest[k];
+            if (!c.wanted || c.settled) return;
+            const Vec2 a = ov.pos(k, u), b = ov.pos(k, live_.layer(k).next[u]);
             if (a == b) return;  // zero length: its point is an end of its neighbours
-            Vec2 c;
-            const double d = point_segment_distance(p, a, b, &c);
+            Vec2 q;
+            const double d = point_segment_distance(p, a, b, &q);
             // check_scene(): the segment of smallest index among equally close ones (input
             // ids run in layer order on an open layer).
-            if (d < best || (d == best && seg != kNone && u < seg)) {
-                best = d;
-                seg = u;
-                closest = c;
+            if (d < c.best || (d == c.best && c.seg != kNone && u < c.seg)) {
+                c.best = d;
+                c.seg = u;
+                c.point = q;
             }
         });
-        if ((seg != kNone && best <= r) || r >= reach_) break;
+        for (Closest& c : closest)
+            if (c.wanted && !c.settled && ((c.seg != kNone && c.best <= r) || r >= reach_)) {
+                c.settled = true;
+                --open;
+            }
     }
-    if (seg == kNone || best == 0.0) return 0;
-    const std::size_t e = w.next[seg];
-    const Vec2 a = ov.pos(k, seg), b = ov.pos(k, e);
-    if (closest == a) {
-        if (w.prev[seg] == kNone) return 0;  // an end of the open layer
-        return corner_side(ov.pos(k, w.prev[seg]), a, b, p);
+}
+
+int LocalCheck::side_of_closest(std::size_t k, const Vec2& p, const Closest& c,
+                                const Overlay& ov) const {
+    if (c.seg == kNone || c.best == 0.0) return 0;
+    const WorkLayer& w = live_.layer(k);
+    const std::size_t e = w.next[c.seg];
+    const Vec2 a = ov.pos(k, c.seg), b = ov.pos(k, e);
+    if (c.point == a) {
+        if (w.prev[c.seg] == kNone) return 0;  // an end of the open layer
+        return corner_side(ov.pos(k, w.prev[c.seg]), a, b, p);
     }
-    if (closest == b) {
+    if (c.point == b) {
         if (w.next[e] == kNone) return 0;
         return corner_side(a, b, ov.pos(k, w.next[e]), p);
     }
     return segment_side(a, b, p);
 }
 
-bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov) const {
+bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
+                             std::vector<Closest>& closest) const {
     const Vec2 p = ov.pos(j, x);
+    closest.assign(live_.size(), Closest{});
     for (std::size_t k = 0; k < live_.size(); ++k) {
         if (k == j || live_.layer(k).closed) continue;
         const Relation r = input_.relation(j, k);
-        if (r != Relation::Under && r != Relation::Over) continue;
+        closest[k].wanted = r == Relation::Under || r == Relation::Over;
+    }
+    sides_against(p, ov, closest);
+    for (std::size_t k = 0; k < live_.size(); ++k) {
+        if (!closest[k].wanted) continue;
         int wanted = sides_.side(j, x, k);
-        if (wanted == 0) wanted = global_side(r, outside_signs_[k]);
-        const int side = side_against(k, p, ov);
+        if (wanted == 0) wanted = global_side(input_.relation(j, k), outside_signs_[k]);
+        const int side = side_of_closest(k, p, closest[k], ov);
         if (side != 0 && side != wanted) return false;
     }
     return true;
@@ -271,10 +290,12 @@ bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov) co
 bool LocalCheck::sides_kept(const Overlay& ov) const {
     if (!open_nesting_) return true;
     const Job& job = *ov.job();
+    std::vector<Closest> closest;
     for (std::size_t r = 0; r < job.runs.size(); ++r) {
         const Run& run = job.runs[r];
         for (std::size_t i = 0; i < run.ids.size(); ++i)
-            if (job.pieces[r].is_free[i] && !keeps_sides(run.layer, run.ids[i], ov)) return false;
+            if (job.pieces[r].is_free[i] && !keeps_sides(run.layer, run.ids[i], ov, closest))
+                return false;
     }
     return true;
 }

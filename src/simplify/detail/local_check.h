@@ -46,12 +46,25 @@ class LocalCheck {
     bool sides_kept(const Overlay& ov) const;
 
   private:
-    /// check_scene()'s side of open layer k at p, at the overlay's positions (0: nothing
+    /// The closest segment of one layer to a point, within reach_.
+    struct Closest {
+        bool wanted = false;   ///< The layer is asked for.
+        bool settled = false;  ///< Found (or nothing within reach_).
+        double best = 0.0;     ///< Its distance.
+        std::size_t seg = kNone;
+        Vec2 point{0.0};  ///< The closest point.
+    };
+    /// The closest segment to p of every layer k with closest[k].wanted, at the overlay's
+    /// positions, as check_scene() finds it (the smallest segment index among equally close
+    /// ones; nothing farther than reach_).
+    void sides_against(const Vec2& p, const Overlay& ov, std::vector<Closest>& closest) const;
+    /// check_scene()'s side of open layer k at p, given its closest segment (0: nothing
     /// closer than reach_, closest to an end, or on the layer).
-    int side_against(std::size_t k, const Vec2& p, const Overlay& ov) const;
+    int side_of_closest(std::size_t k, const Vec2& p, const Closest& c, const Overlay& ov) const;
     /// Vertex x of layer j, at its overlay position, is on its wanted side of every open layer
-    /// k it nests with.
-    bool keeps_sides(std::size_t j, std::size_t x, const Overlay& ov) const;
+    /// k it nests with. `closest`: scratch.
+    bool keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
+                     std::vector<Closest>& closest) const;
     bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
                         const Vec2& w) const;
     bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
