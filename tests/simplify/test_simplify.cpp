@@ -297,6 +297,40 @@ TEST_CASE("shape matching keeps the vertices of a layer apart", "[simplify]") {
     CHECK(closest > 0.5 * median);
 }
 
+TEST_CASE("collinear vertices of straight layers are removed without untangling", "[simplify]") {
+    // A vertex on a straight stretch leaves a flat triangle: the other vertices of that
+    // line are not inside it (they once were, for every vertex of the line through it: such
+    // removals went to an untangling, and some were refused).
+    std::vector<Layer> layers;
+    for (std::size_t k = 0; k < 3; ++k) {
+        Layer layer;
+        layer.name = "L" + std::to_string(k);
+        layer.thickness = 0.2;
+        for (std::size_t i = 0; i < 60; ++i)
+            layer.points.emplace_back(0.5 * static_cast<double>(i), static_cast<double>(k));
+        layers.push_back(layer);
+    }
+    const Scene input(layers);
+    for (const char* decimator : {"visvalingam", "random"}) {
+        for (const UntangleSchedule schedule :
+             {UntangleSchedule::Deferred, UntangleSchedule::Immediate}) {
+            SimplifyParams params;
+            params.decimator = decimator;
+            params.schedule = schedule;
+            params.remove = 0.95;
+            Scene out = input;
+            const SimplifyReport report = simplify(out, params);
+            INFO(
+                decimator << (schedule == UntangleSchedule::Deferred ? " deferred" : " immediate"));
+            CHECK(report.refused == 0);
+            CHECK(report.untangle_calls == 0);
+            CHECK(report.targets_met);
+            CHECK(report.collision_free);
+            for (const Layer& layer : out.layers()) CHECK(layer.points.size() == 3);
+        }
+    }
+}
+
 TEST_CASE("max-error bounds the naive decimation's Hausdorff distance", "[simplify]") {
     const Scene input = stack(3, 300, false);
     SimplifyParams params;

@@ -11,7 +11,15 @@ namespace strata::detail {
 
 namespace {
 
+// p lies in the closed triangle (a, b, c). The box test first: it is exact, rejects most
+// points without a predicate, and is what decides for a flat triangle (collinear a, b, c),
+// where every point of the line through them has three zero orientations.
 bool point_in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
+    Box2 box;
+    box.extend(a);
+    box.extend(b);
+    box.extend(c);
+    if (!box.contains(p)) return false;
     const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
     return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
 }
