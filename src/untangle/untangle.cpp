@@ -24,10 +24,13 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         for (const Piece& piece : pieces)
             report.free_vertices +=
                 static_cast<std::size_t>(std::count(piece.is_free.begin(), piece.is_free.end(), 1));
+        // Orientation of open layers from the input, where the nesting is the intended one:
+        // what the untangling pushes toward, and what its checks judge by (a fresh vote on
+        // the result could flip a short layer's outside and call a swapped order clean).
+        detail::EngineSettings settings = detail::resolve_settings(scene, params);
         CheckParams check_params;
         check_params.separation_tolerance = params.separation_tolerance;
-        // Orientation of open layers from the input, where the nesting is the intended one.
-        detail::EngineSettings settings = detail::resolve_settings(scene, params);
+        check_params.outside_sides = settings.outside_signs;
         // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
         settings.rest_at_start = true;
         CheckReport check = check_scene(scene, check_params);
