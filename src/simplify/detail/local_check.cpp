@@ -305,6 +305,16 @@ bool LocalCheck::sides_kept(const Overlay& ov) const {
             if (job.pieces[r].is_free[i] && !keeps_sides(run.layer, run.ids[i], ov, closest))
                 return false;
     }
+    // The ends of the open layers near the job, moved or not: at a high removal a rolled part
+    // is often down to the end of its layer, whose side changes when the layer it lies over
+    // is moved under it (the one unmoved case tested here; see the header).
+    const Box2 near = span_of(job).inflated(reach_);
+    for (std::size_t j = 0; j < live_.size(); ++j) {
+        const WorkLayer& w = live_.layer(j);
+        if (w.closed || w.pos.empty()) continue;
+        for (const std::size_t end : {std::size_t{0}, w.pos.size() - 1})
+            if (near.contains(ov.pos(j, end)) && !keeps_sides(j, end, ov, closest)) return false;
+    }
     return true;
 }
 

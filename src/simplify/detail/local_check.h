@@ -39,10 +39,12 @@ class LocalCheck {
     /// own that the input gives it (`sides`), or that the global order asks for where the
     /// input gives none, as check_scene() judges it (the side at the closest point within the
     /// near distance of the input, automatic_near_distance()). A vertex carried around the end
-    /// of an open layer crosses nothing; this is what catches it. Not checked here: a vertex
-    /// the job does not move whose closest point moves with an open layer (scanning every
-    /// vertex within the near distance of the moved segments took 44 of 49 CPU seconds of a
-    /// 1M-vertex stack at 95%); the final whole-scene check still judges every vertex.
+    /// of an open layer crosses nothing; this is what catches it. The end vertices of the
+    /// open layers within that distance of the job are tested too, moved or not. Not checked
+    /// here: another vertex the job does not move whose closest point moves with an open layer
+    /// (scanning every vertex within the near distance of the moved segments took 44 of 49 CPU
+    /// seconds of a 1M-vertex stack at 95%); the final whole-scene check still judges every
+    /// vertex.
     bool sides_kept(const Overlay& ov) const;
 
   private:
