@@ -120,6 +120,52 @@ TEST_CASE("the finishing stage brings a vertex poking through back to its side",
     CHECK(scene.layer(0).points[5].y < scene.layer(1).points[5].y);
 }
 
+TEST_CASE("the finishing stage takes a poke out of a side-by-side open layer", "[separation]") {
+    // Two open pieces side by side (no side asked of either): vertex 5 of the lower one pokes
+    // 0.01 through the upper one, between two of its vertices. The side it belongs on is the
+    // one the rest of its layer is on.
+    Layer lower = horizontal("lower", 0.0, 0.02);
+    Layer upper = horizontal("upper", 0.04, 0.02, 0.0, 0.05);
+    lower.outer = std::vector<std::string>{};
+    upper.outer = std::vector<std::string>{};
+    lower.points[5].y = 0.05;
+    Scene scene({lower, upper});
+    REQUIRE(scene.relation(0, 1) == Relation::SideBySide);
+    REQUIRE(check_scene(scene).crossing_count == 2);
+    const detail::SeparationResult r = finish(scene);
+    CHECK(r.moves > 0);
+    test::require_collision_free(scene, 0.1);
+    CHECK(scene.layer(0).points[5].y < scene.layer(1).points[5].y);
+}
+
+TEST_CASE("the finishing stage pulls back an open end that crosses a side-by-side piece",
+          "[separation]") {
+    // The last two vertices of an open piece dangle 0.01 over another open piece side by side
+    // (its last segment but one crosses it once): they belong on the side of the rest. The
+    // end vertex is free here (finish() fixes the ends: the pieces are set by hand).
+    Layer lower = horizontal("lower", 0.0, 0.02);
+    Layer upper = polyline("upper", {{0.0, 0.04}, {0.6, 0.04}, {1.2, 0.04}}, 0.02);
+    lower.outer = std::vector<std::string>{};
+    upper.outer = std::vector<std::string>{};
+    lower.points[9].y = 0.05;
+    lower.points[10].y = 0.05;
+    Scene scene({lower, upper});
+    REQUIRE(scene.relation(0, 1) == Relation::SideBySide);
+    REQUIRE(check_scene(scene).crossing_count == 1);
+    std::vector<Piece> pieces = whole_scene_pieces(scene);
+    pieces[1].is_free.assign(pieces[1].is_free.size(), 0);  // the upper piece stays
+    detail::RelationSource relations;
+    relations.scene = &scene;
+    std::vector<int> sides;
+    for (std::size_t i = 0; i < scene.size(); ++i) sides.push_back(outside_side(scene, i));
+    detail::SeparationParams params;
+    params.outside_signs = &sides;
+    const detail::SeparationResult r = detail::finish_separations(scene, pieces, relations, params);
+    CHECK(r.moves > 0);
+    test::require_collision_free(scene, 0.1);
+    CHECK(scene.layer(0).points[10].y < 0.04);
+}
+
 TEST_CASE("the finishing stage never makes a crossing (random stacks)", "[separation]") {
     // Wavy stacks of 4 layers whose gaps are drawn below and above the required separation,
     // with their fixed ends fanned out: what the stage cannot fix it must leave uncrossed,

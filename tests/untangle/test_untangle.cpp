@@ -207,6 +207,27 @@ TEST_CASE("naive decimation of real slices is untangled", "[untangle][slices]") 
     }
 }
 
+TEST_CASE("real slices whose suit pieces cross side by side are untangled", "[untangle][slices]") {
+    // Issues 13 and 15: open suit pieces side by side (no side asked of either) that the
+    // input already crosses, near their ends. untangle() with its defaults must leave no
+    // crossing or self-crossing, keep the nesting and keep the gaps (0.9 x the required
+    // separation, or the input's own ratio when it is below that).
+    for (const char* name : {"mh_casualsuit05_y+2.50.json", "mh_casualsuit05_y+6.00.json",
+                             "mh_casualsuit05_y+6.50.json"}) {
+        INFO(name);
+        Scene scene = read_scene_json(test::test_data(std::string("crossing_slices/") + name));
+        const double input_ratio = check_scene(scene).min_separation_ratio;
+        REQUIRE_FALSE(check_scene(scene).is_collision_free());
+        const UntangleReport report = untangle(scene);
+        CHECK(report.collision_free);
+        const CheckReport after = check_scene(scene);
+        CHECK(after.crossing_count == 0);
+        CHECK(after.total_self_crossings() == 0);
+        CHECK(after.nesting_violation_count == 0);
+        CHECK(after.min_separation_ratio >= 0.9 * std::min(1.0, input_ratio));
+    }
+}
+
 TEST_CASE("bad untangle parameters are rejected by name", "[untangle]") {
     Scene scene = test::nested_circles(2, 16);
     UntangleParams params;

@@ -282,14 +282,18 @@ class Finisher {
             auto it = std::find_if(nearest_.begin(), nearest_.end(),
                                    [&](const Nearest& x) { return x.layer == s.layer; });
             if (it == nearest_.end())
-                nearest_.push_back({s.layer, i, d, false});
+                nearest_.push_back({s.layer, i, d, false, 0});
             else if (d < it->distance)
-                *it = {s.layer, i, d, false};
+                *it = {s.layer, i, d, false, 0};
         }
         for (Nearest& x : nearest_) {
             const SegId& s = found_[x.index];
             const Vec2 q0 = cells_->start(s), q1 = cells_->end(s), p = pts_[l][v];
-            const int wanted = wanted_side(l, v, s.layer);
+            int wanted = wanted_side(l, v, s.layer);
+            // No side asked of an open layer: the side the rest of the vertex's run is on.
+            if (wanted == 0 && !closed_[s.layer] && x.distance < tangle_reach_)
+                wanted = poke_side(l, v, q0, q1);
+            x.wanted = wanted;
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
                          orient2d(q0, q1, p) != wanted;
         }
@@ -314,7 +318,7 @@ class Finisher {
             double shortfall = aim - d;
             if (near.is_wrong) {  // over to the side it belongs on, at the aim
                 const Vec2 left(-e.y, e.x);  // orient2d(q0, q1, q0 + left) = +1
-                normal = static_cast<double>(wanted_side(l, v, m)) * left / std::sqrt(e2);
+                normal = static_cast<double>(near.wanted) * left / std::sqrt(e2);
                 shortfall = aim + d;
                 ++wrong_side_;
             } else if (!(d < aim)) {
@@ -346,8 +350,9 @@ class Finisher {
 
     // The side of layer m's segments (orient2d sign) that layer l's vertices must be on, by
     // the nesting: inside m when l is under m, outside when over; 0 when any side will do
-    // (side-by-side layers push apart whatever the side). Vertex v keeps the other side where
-    // the input has it there, or any side around an end of m (RelationSource::local_sides).
+    // (side-by-side layers push apart whatever the side; see poke_side() for open m). Vertex v
+    // keeps the other side where the input has it there, or any side around an end of m
+    // (RelationSource::local_sides).
     int wanted_side(std::size_t l, std::size_t v, std::size_t m) const {
         const Relation r = relation_[l * pts_.size() + m];
         if (r == Relation::SideBySide || params_.outside_signs == nullptr ||
@@ -363,6 +368,43 @@ class Finisher {
             default:
                 return wanted;
         }
+    }
+
+    // Where no side is asked for (side-by-side layers, any side): the side of segment
+    // (q0, q1) of another layer that vertex (l, v) pokes through from. Walking along layer l
+    // from v both ways (at most kPokeRun segments each), the first segments that properly
+    // cross (q0, q1) bound a run of l that lies on the other side of it than the rest of the
+    // layer; an end of an open layer reached first bounds it too (a dangling end), but not
+    // on both sides. Returns the side of (q0, q1) that the rest of the layer is on, the one
+    // v belongs on, or 0 when v is not in such a run.
+    int poke_side(std::size_t l, std::size_t v, const Vec2& q0, const Vec2& q1) const {
+        constexpr std::size_t kPokeRun = 8;
+        const std::vector<Vec2>& x = pts_[l];
+        const std::size_t n = x.size();
+        const int own = orient2d(q0, q1, x[v]);
+        if (own == 0 || n < 2) return 0;
+        int bounded = 0, ends = 0;
+        for (int dir : {-1, 1}) {
+            std::size_t k = v;
+            bool found = false;
+            for (std::size_t step = 0; step < kPokeRun && step + 1 < n; ++step) {
+                const bool at_end = dir < 0 ? (!closed_[l] && k == 0) : (!closed_[l] && k + 1 == n);
+                if (at_end) {
+                    ++ends;
+                    found = true;
+                    break;
+                }
+                const std::size_t j = dir < 0 ? (k + n - 1) % n : (k + 1) % n;
+                if (segment_contact(x[k], x[j], q0, q1) == SegmentContact::Proper) {
+                    ++bounded;
+                    found = true;
+                    break;
+                }
+                k = j;
+            }
+            if (!found) return 0;
+        }
+        return bounded >= 1 && ends <= 1 ? -own : 0;
     }
 
     // Moves vertex (l, v) by `delta`, or by a half, a quarter or an eighth of it when the full
@@ -448,6 +490,7 @@ class Finisher {
         std::size_t layer, index;  // index into found_
         double distance;
         bool is_wrong;
+        int wanted;  // the side the vertex must be on (orient2d sign), 0: any
     };
     std::vector<Nearest> nearest_;
     std::optional<SegmentCells> cells_;
