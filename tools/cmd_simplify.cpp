@@ -61,6 +61,11 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             "gap rule: %zu pairs of layers without thickness keep their share of the "
             "input gap (--keep-gaps)\n",
             r.raised_separations);
+    if (r.restored > 0)
+        std::printf(
+            "last resort: the exact check of the result failed where the local checks could "
+            "not see; %zu input vertices came back around it\n",
+            r.restored);
     if (r.rolled_vertices > 0)
         std::printf(
             "local sides: %zu output vertices lie on the other side of an open layer than the "

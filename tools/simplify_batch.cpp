@@ -67,6 +67,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"targets_met", r.targets_met},
                         {"raised_separations", r.raised_separations},
                         {"rolled_vertices", r.rolled_vertices},
+                        {"restored", r.restored},
                         {"crossings", r.crossings},
                         {"self_crossings", r.self_crossings},
                         {"nesting_violations", r.nesting_violations},

@@ -377,6 +377,8 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("batches", &SimplifyReport::batches)
         .def_readonly("targets_met", &SimplifyReport::targets_met)
         .def_readonly("raised_separations", &SimplifyReport::raised_separations)
+        .def_readonly("rolled_vertices", &SimplifyReport::rolled_vertices)
+        .def_readonly("restored", &SimplifyReport::restored)
         .def_readonly("crossings", &SimplifyReport::crossings)
         .def_readonly("self_crossings", &SimplifyReport::self_crossings)
         .def_readonly("nesting_violations", &SimplifyReport::nesting_violations)

@@ -8,12 +8,14 @@
 //   local_check.h      the exact test that a removal or an untangling keeps its region clean
 //   job_runner.h       prepares, executes and applies untangling jobs
 //   scheduler.h        the queue of removals, the deferred and immediate schedules, batches
-// then checks the whole result exactly (check_scene()).
+// then checks the whole result exactly (check_scene()), and where that still fails
+//   restore.h          puts the input back around what is wrong until it passes.
 #include "strata/simplify/simplify.h"
 
 #include "simplify/detail/job_runner.h"
 #include "simplify/detail/live_polylines.h"
 #include "simplify/detail/local_check.h"
+#include "simplify/detail/restore.h"
 #include "simplify/detail/scheduler.h"
 #include "simplify/detail/separations.h"
 #include "strata/core/error.h"
@@ -24,6 +26,7 @@
 #include "untangle/detail/engine.h"
 
 #include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -123,7 +126,18 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     const InputSides output_sides = input_sides.renumbered(report.origins);
     report.rolled_vertices = output_sides.rolled_count(out, outside_signs);
     check_params.input_sides = &output_sides;
-    const CheckReport check_report = check_scene(out, check_params);
+    CheckReport check_report = check_scene(out, check_params);
+    if (params.untangle && !detail::passes(check_report)) {
+        // What the local checks could not see: the input comes back around it.
+        detail::Restored restored = detail::restore_near_violations(input, live, out, check_report,
+                                                                    check_params, input_sides);
+        out = std::move(restored.scene);
+        report.origins = std::move(restored.origins);
+        check_report = std::move(restored.check);
+        report.restored = restored.restored;
+        report.rolled_vertices =
+            input_sides.renumbered(report.origins).rolled_count(out, outside_signs);
+    }
     report.crossings = check_report.crossing_count;
     report.self_crossings = check_report.total_self_crossings();
     report.nesting_violations = check_report.nesting_violation_count;
@@ -139,7 +153,10 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
         r.before = before.points.size();
         r.after = after.points.size();
         r.target = live.layer(l).target;
-        r.max_displacement = live.max_displacement(l);
+        for (std::size_t k = 0; k < after.points.size(); ++k)
+            r.max_displacement = std::max(
+                r.max_displacement,
+                glm::distance(after.points[k], input.layer(l).points[report.origins[l][k]]));
         if (r.after > r.target) report.targets_met = false;
     }
     tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t l) {

@@ -120,6 +120,12 @@ struct SimplifyReport {
     /// other layer): the simplification keeps the input's sides (strata/geometry/input_sides.h).
     /// The nesting violations above are vertices that changed side relative to the input.
     std::size_t rolled_vertices = 0;
+    /// Input vertices put back (or moved back to their input position) by the last resort:
+    /// where the exact check of the whole result still failed (what the local checks do not
+    /// see: a vertex that did not move whose closest point on an open layer moved), the input
+    /// came back within a radius of each violation, doubled until the check passed. 0 almost
+    /// always; never when untangle is false (naive decimation keeps its collisions).
+    std::size_t restored = 0;
     /// Per layer, the input index of every output vertex, in output order (a simplification
     /// keeps vertices and their order; InputSides::renumbered() takes it).
     std::vector<std::vector<std::size_t>> origins;

@@ -111,12 +111,4 @@ Scene LivePolylines::to_scene(const Scene& input) const {
     return out;
 }
 
-double LivePolylines::max_displacement(std::size_t l) const {
-    const WorkLayer& w = layers_[l];
-    double d = 0.0;
-    for (std::size_t i = 0; i < w.alive.size(); ++i)
-        if (w.alive[i]) d = std::max(d, glm::distance(w.pos[i], w.original[i]));
-    return d;
-}
-
 }  // namespace strata::detail

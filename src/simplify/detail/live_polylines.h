@@ -48,8 +48,6 @@ class LivePolylines {
     Scene to_scene(const Scene& input) const;
     /// Per layer, the input id of every vertex of to_scene(), in the same order.
     std::vector<std::vector<std::size_t>> origins() const;
-    /// Largest distance of an alive vertex of layer l from its input position.
-    double max_displacement(std::size_t l) const;
 
     /// The grid's name of the segment starting at vertex i of layer l.
     static SegRef ref(std::size_t l, std::size_t i) {

@@ -1,0 +1,41 @@
+#pragma once
+/// @file The last resort of simplify(): where the exact check of the whole result still finds
+/// a crossing, a separation or a side the local checks could not see (a vertex that did not
+/// move whose closest point on an open layer moved with that layer), the input comes back
+/// around it: every input vertex within a radius of a violation is put back at its input
+/// position, and the radius doubles until the result is clean. The whole input is the last
+/// step, so a clean input always gives a clean result. Private to src/simplify.
+
+#include "simplify/detail/live_polylines.h"
+#include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
+#include "strata/geometry/scene.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace strata::detail {
+
+/// A result of restore_near_violations().
+struct Restored {
+    Scene scene;                                    ///< The result, vertices in input order.
+    std::vector<std::vector<std::size_t>> origins;  ///< Per layer, the input id of each vertex.
+    CheckReport check;                              ///< check_scene() of `scene`.
+    std::size_t restored = 0;  ///< Input vertices put back, or moved back to their input place.
+    int steps = 0;             ///< Radii tried.
+};
+
+/// @brief Puts the input back around the violations of `check` (the report on `out`, the
+/// scene of `live`) until the exact check passes. `params`: the check's parameters, whose
+/// input_sides (if any) is replaced by `sides` renumbered to each candidate. The raised
+/// separations of `input` carry over.
+Restored restore_near_violations(const Scene& input, const LivePolylines& live, const Scene& out,
+                                 const CheckReport& check, CheckParams params,
+                                 const InputSides& sides);
+
+/// Whether `report` passes: no crossing, nesting kept, separations within tolerance.
+inline bool passes(const CheckReport& report) {
+    return report.is_collision_free() && report.separations_hold();
+}
+
+}  // namespace strata::detail
