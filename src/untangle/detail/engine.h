@@ -3,6 +3,7 @@
 /// projection + shape matching over fields built from a work scene whose layers may stand for
 /// layers (or parts of layers) of another scene.
 
+#include "strata/geometry/input_sides.h"
 #include "strata/untangle/untangle.h"
 
 #include <functional>
@@ -56,6 +57,18 @@ struct RelationSource {
         return Side::Global;
     }
 };
+
+/// Sets relations.local_sides from sides recorded in relations.scene (input_sides.h): a vertex
+/// whose recorded side of an open layer under or over its own is not the one the global order
+/// gives (`outside_signs`: outside_side() of every layer of relations.scene) takes that layer's
+/// work layers on its own side (Flipped), and a vertex around an end of that layer keeps its
+/// distance on any side (AnySide). Vertex k of work layer i is vertex id_of(i, k) of layer
+/// relations.of(i) (empty id_of: k itself); `work` gives the work layers' vertex counts.
+/// Nothing is set when no vertex has such a side (local_sides stays empty). Shared by
+/// untangle() (the whole scene) and the simplification driver (a job's runs).
+void take_input_sides(RelationSource& relations, const Scene& work, const InputSides& sides,
+                      const std::vector<int>& outside_signs,
+                      const std::function<std::size_t(std::size_t, std::size_t)>& id_of = {});
 
 /// Scene-wide settings of the engine, resolved once.
 struct EngineSettings {
