@@ -585,7 +585,9 @@ EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params
     settings.diagonal = std::max(std::hypot(size.x, size.y), std::numeric_limits<double>::min());
     settings.outside_signs.resize(scene.size());
     for (std::size_t i = 0; i < scene.size(); ++i)
-        settings.outside_signs[i] = outside_side(scene, i);
+        settings.outside_signs[i] = i < params.outside_sides.size() && !scene.layer(i).closed
+                                        ? params.outside_sides[i]
+                                        : outside_side(scene, i);
     return settings;
 }
 

@@ -99,7 +99,8 @@ struct EngineResult {
     double seconds_finish = 0.0;
 };
 
-/// Resolves the automatic min_separation and sample_spacing from `scene` and the params.
+/// Resolves the automatic min_separation and sample_spacing from `scene` and the params, and
+/// the outside signs (params.outside_sides where given, else outside_side() of `scene`).
 EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params);
 
 /// Runs passes (fields built from `work` at the start of each) until is_ok(work) holds or
