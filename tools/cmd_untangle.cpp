@@ -29,6 +29,7 @@ struct UntangleOptions {
     double thickness = 0.0;
     bool no_shape_matching = false;
     bool no_finish = false;
+    bool infer_sides = false;
     UntangleParams params;
 };
 
@@ -48,6 +49,11 @@ Run add_untangle_command(CLI::App& app) {
                     "Original scene (before decimation), layers matched by name: every vertex "
                     "keeps the side of the open layers it has there (a rolled or folded-over "
                     "part stays so); without it, the global order everywhere");
+    cmd->add_flag("--infer-sides", opt->infer_sides,
+                  "Without the original: take the sides of the open layers from the input "
+                  "itself, each region of a layer on the side most of its vertices are (a "
+                  "rolled part stays so, a vertex a tangle put across takes its region's)")
+        ->excludes("--reference");
     cmd->add_option("--thickness", opt->thickness,
                     "Thickness for layers whose thickness is 0 (scene units)")
         ->capture_default_str();
@@ -80,16 +86,23 @@ Run add_untangle_command(CLI::App& app) {
         const Scene input = with_default_thickness(read_scene(opt->input), opt->thickness);
         for (const std::string& note : input.diagnostics().notes)
             std::cerr << "strata: note: " << opt->input << ": " << note << '\n';
-        // The original's sides of its open layers, kept where they are not the global order's.
+        // The original's sides of its open layers (or the input's own, per region), kept
+        // where they are not the global order's.
         std::optional<Reference> reference;
+        InputSides inferred;
         CheckParams check_params;
         if (!opt->reference.empty()) {
             reference = read_reference(opt->reference, input, 0.0, true, opt->thickness);
             params.outside_sides = reference->outside_sides;
             params.input_sides = &reference->sides;  // untangling keeps the vertex indices
-            check_params.outside_sides = reference->outside_sides;
-            check_params.input_sides = &reference->sides;
+        } else if (opt->infer_sides) {
+            inferred = infer_input_sides(input);
+            for (std::size_t l = 0; l < input.size(); ++l)
+                params.outside_sides.push_back(outside_side(input, l));
+            params.input_sides = &inferred;
         }
+        check_params.outside_sides = params.outside_sides;
+        check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();
         const UntangleReport r = untangle(scene, params, terminal_progress());
@@ -129,10 +142,10 @@ Run add_untangle_command(CLI::App& app) {
                   {"total", seconds}}},
                 {"finishes", r.finishes},
                 {"finish_moves", r.finish_moves}};
-            if (reference)
-                j["reference"] = {{"file", opt->reference},
-                                  {"rolled_vertices", r.rolled_vertices},
-                                  {"rolled_kept", r.rolled_kept}};
+            if (params.input_sides)
+                j["sides"] = {{"from", reference ? opt->reference : "inferred"},
+                              {"rolled_vertices", r.rolled_vertices},
+                              {"rolled_kept", r.rolled_kept}};
             write_file_atomic(opt->report, j.dump(2) + "\n");
         }
         std::printf("%s -> %s: %zu layers, %zu vertices\n", opt->input.c_str(), opt->output.c_str(),
@@ -140,11 +153,13 @@ Run add_untangle_command(CLI::App& app) {
         std::printf(
             "crossings between layers: %zu before, %zu after; nesting violations after: %zu\n",
             r.crossings_before, r.crossings_after, after.nesting_violation_count);
-        if (reference)
+        if (params.input_sides)
             std::printf(
-                "sides from %s: %zu vertices on a rolled side (the other side of an open layer "
+                "sides %s %s: %zu vertices on a rolled side (the other side of an open layer "
                 "than the global order), %zu kept it\n",
-                opt->reference.c_str(), r.rolled_vertices, r.rolled_kept);
+                reference ? "from" : "inferred from",
+                reference ? opt->reference.c_str() : opt->input.c_str(), r.rolled_vertices,
+                r.rolled_kept);
         std::printf(
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
             "%.4g\n",
