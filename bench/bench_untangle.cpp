@@ -12,6 +12,7 @@
 // moved vertices, the largest Hausdorff distance of a layer to its un-decimated input.
 // Usage: strata_bench_untangle [--family NAME] [--tangle naive90|naive95|dp]
 //                              [--backend indexed|grid] [--points N] [--timing] [--write DIR]
+//                              [--sides]
 // --write DIR: every case's tangled input (NAME.tangled.json) and result (NAME.json, and
 // NAME.svg with the tangled input drawn faintly under it), DIR existing.
 // --timing: the two timing cases instead (12 loops x 150 and 6 x 300 stack, naive 90%).
@@ -19,9 +20,14 @@
 // scenes of DIR (.json, .svg) whose input already crosses, untangled as they are (tangle
 // "real"): slices of real garments (../shared/data/garments, bench/garments.sh) where the
 // meshes interpenetrate. "--slices none" leaves them out.
+// --sides: the un-decimated input is the reference, as `strata untangle --reference` has it:
+// its sides of the open layers (record_input_sides(), matched onto the tangled scene) are kept
+// (UntangleParams::input_sides, outside_sides), and nesting is scored against them (a rolled
+// part must stay rolled). Real slices are untangled as they are (their input is the tangle).
 
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/io/scene_io.h"
 #include "strata/io/svg_io.h"
 #include "strata/simplify/scene_families.h"
@@ -139,26 +145,39 @@ struct Row {
     bool capped = false;
 };
 
-std::string write_dir;  // --write
+std::string write_dir;    // --write
+bool keep_sides = false;  // --sides
 
 Row run(const std::string& name, const std::string& how, const Scene& input,
         const UntangleParams& params, double cap_seconds) {
     const CheckReport original = check_scene(input);
     const Scene tangled = how == "real" ? input : tangle(input, how);
-    const CheckReport before = check_scene(tangled);
+    // --sides: the input's sides carried onto the tangled scene, kept and scored.
+    UntangleParams p = params;
+    CheckParams scoring;
+    InputSides sides;
+    if (keep_sides && how != "real") {
+        for (std::size_t l = 0; l < input.size(); ++l)
+            p.outside_sides.push_back(outside_side(input, l));
+        sides = InputSides::matched(record_input_sides(input), input, tangled);
+        p.input_sides = &sides;
+        scoring.outside_sides = p.outside_sides;
+        scoring.input_sides = &sides;
+    }
+    const CheckReport before = check_scene(tangled, scoring);
     Scene scene = tangled;
     const double start = now();
     Row row;
     UntangleReport report;
     try {
-        report = untangle(scene, params,
+        report = untangle(scene, p,
                           [&](std::string_view, double) { return now() - start < cap_seconds; });
     } catch (const Cancelled&) {
         row.capped = true;
         scene = tangled;
     }
     const double seconds = now() - start;
-    const CheckReport after = check_scene(scene);
+    const CheckReport after = check_scene(scene, scoring);
     const double bar = 0.9 * std::min(1.0, original.min_separation_ratio);
     row.clean = !row.capped && after.is_collision_free() && after.min_separation_ratio >= bar;
     double hausdorff = 0.0;
@@ -230,11 +249,13 @@ int main(int argc, char** argv) {
             write_dir = value();
         else if (key == "--slices")
             slices = value();
+        else if (key == "--sides")
+            keep_sides = true;
         else {
             std::fprintf(stderr,
                          "usage: strata_bench_untangle [--family NAME] [--tangle "
                          "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
-                         "[--timing] [--write DIR] [--slices DIR|none]\n");
+                         "[--timing] [--write DIR] [--slices DIR|none] [--sides]\n");
             return 2;
         }
     }

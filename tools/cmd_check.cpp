@@ -1,5 +1,6 @@
 // strata check: exact collision checks of a scene, as a table or JSON.
 #include "commands.h"
+#include "reference.h"
 
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
@@ -193,40 +194,24 @@ Run add_check_command(CLI::App& app) {
         const Scene scene = read_scene(opt->input);
         for (const std::string& note : scene.diagnostics().notes)
             std::cerr << "strata: note: " << opt->input << ": " << note << '\n';
-        std::optional<Scene> reference;
         CheckParams params = opt->params;
-        if (!opt->reference.empty()) {
-            reference = read_scene(opt->reference);
-            // An open layer simplified to a few vertices gets its side from its original.
-            for (std::size_t i = 0; i < scene.size(); ++i) {
-                const auto j = reference->find(scene.layer(i).name);
-                // The near distance the checker's own vote would use (0: automatic).
-                params.outside_sides.push_back(
-                    j && !reference->layer(*j).closed
-                        ? outside_side(*reference, *j, params.near_distance)
-                        : outside_side(scene, i, params.near_distance));
-            }
-        }
         // The reference's own sides of its open layers (a rolled part): a nesting violation is
-        // a vertex that left the side its reference has.
-        InputSides reference_sides;
-        std::size_t rolled = 0;
-        if (reference) {
-            const InputSides recorded = record_input_sides(*reference);
-            std::vector<int> reference_outside;
-            for (std::size_t l = 0; l < reference->size(); ++l)
-                reference_outside.push_back(outside_side(*reference, l, params.near_distance));
-            rolled = recorded.rolled_count(*reference, reference_outside);
-            reference_sides = InputSides::matched(recorded, *reference, scene);
-            params.input_sides = &reference_sides;
+        // a vertex that left the side its reference has. Its outside sides: an open layer
+        // simplified to a few vertices gets its side from its original.
+        std::optional<Reference> reference;
+        if (!opt->reference.empty()) {
+            reference = read_reference(opt->reference, scene, params.near_distance, false);
+            params.outside_sides = reference->outside_sides;
+            params.input_sides = &reference->sides;
         }
+        const std::size_t rolled = reference ? reference->rolled : 0;
         const CheckReport report = check_scene(scene, params);
         std::vector<std::optional<HausdorffDistance>> h;
         if (reference) {
             Box2 box = scene.bounds();
-            box.extend(reference->bounds());
+            box.extend(reference->scene.bounds());
             const double diagonal = std::hypot(box.size().x, box.size().y);
-            h = hausdorff_to(scene, *reference,
+            h = hausdorff_to(scene, reference->scene,
                              opt->hausdorff_tolerance * std::max(diagonal, 1e-300));
         }
         const bool ok = report.is_collision_free() && (!opt->strict || report.separations_hold());

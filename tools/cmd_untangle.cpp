@@ -1,6 +1,7 @@
 // strata untangle: global untangling of a scene that is already tangled.
 #include "cli_util.h"
 #include "commands.h"
+#include "reference.h"
 
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace strata::cli {
@@ -23,10 +25,11 @@ namespace strata::cli {
 namespace {
 
 struct UntangleOptions {
-    std::string input, output, svg, report;
+    std::string input, output, svg, report, reference;
     double thickness = 0.0;
     bool no_shape_matching = false;
     bool no_finish = false;
+    bool infer_sides = false;
     UntangleParams params;
 };
 
@@ -42,6 +45,15 @@ Run add_untangle_command(CLI::App& app) {
     cmd->add_option("-o,--output", opt->output, "Untangled scene (.json or .svg)")->required();
     cmd->add_option("--svg", opt->svg, "Picture: the result over the input (faint)");
     cmd->add_option("--report", opt->report, "Report as JSON");
+    cmd->add_option("--reference", opt->reference,
+                    "Original scene (before decimation), layers matched by name: every vertex "
+                    "keeps the side of the open layers it has there (a rolled or folded-over "
+                    "part stays so); without it, the global order everywhere");
+    cmd->add_flag("--infer-sides", opt->infer_sides,
+                  "Without the original: take the sides of the open layers from the input "
+                  "itself, each region of a layer on the side most of its vertices are (a "
+                  "rolled part stays so, a vertex a tangle put across takes its region's)")
+        ->excludes("--reference");
     cmd->add_option("--thickness", opt->thickness,
                     "Thickness for layers whose thickness is 0 (scene units)")
         ->capture_default_str();
@@ -69,17 +81,34 @@ Run add_untangle_command(CLI::App& app) {
         if (opt->no_shape_matching) params.shape = ShapeMode::None;
         if (opt->no_finish) params.finish_separations = false;
         validate(params);
-        check_outputs({opt->output, opt->svg, opt->report}, {opt->input});
+        check_outputs({opt->output, opt->svg, opt->report}, {opt->input, opt->reference});
         scene_format(opt->output);  // reject a bad extension before working
         const Scene input = with_default_thickness(read_scene(opt->input), opt->thickness);
         for (const std::string& note : input.diagnostics().notes)
             std::cerr << "strata: note: " << opt->input << ": " << note << '\n';
+        // The original's sides of its open layers (or the input's own, per region), kept
+        // where they are not the global order's.
+        std::optional<Reference> reference;
+        InputSides inferred;
+        CheckParams check_params;
+        if (!opt->reference.empty()) {
+            reference = read_reference(opt->reference, input, 0.0, true, opt->thickness);
+            params.outside_sides = reference->outside_sides;
+            params.input_sides = &reference->sides;  // untangling keeps the vertex indices
+        } else if (opt->infer_sides) {
+            inferred = infer_input_sides(input);
+            for (std::size_t l = 0; l < input.size(); ++l)
+                params.outside_sides.push_back(outside_side(input, l));
+            params.input_sides = &inferred;
+        }
+        check_params.outside_sides = params.outside_sides;
+        check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();
         const UntangleReport r = untangle(scene, params, terminal_progress());
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const CheckReport after = check_scene(scene);
+        const CheckReport after = check_scene(scene, check_params);
 
         write_scene(scene, opt->output);
         if (!opt->svg.empty()) {
@@ -113,6 +142,10 @@ Run add_untangle_command(CLI::App& app) {
                   {"total", seconds}}},
                 {"finishes", r.finishes},
                 {"finish_moves", r.finish_moves}};
+            if (params.input_sides)
+                j["sides"] = {{"from", reference ? opt->reference : "inferred"},
+                              {"rolled_vertices", r.rolled_vertices},
+                              {"rolled_kept", r.rolled_kept}};
             write_file_atomic(opt->report, j.dump(2) + "\n");
         }
         std::printf("%s -> %s: %zu layers, %zu vertices\n", opt->input.c_str(), opt->output.c_str(),
@@ -120,6 +153,13 @@ Run add_untangle_command(CLI::App& app) {
         std::printf(
             "crossings between layers: %zu before, %zu after; nesting violations after: %zu\n",
             r.crossings_before, r.crossings_after, after.nesting_violation_count);
+        if (params.input_sides)
+            std::printf(
+                "sides %s %s: %zu vertices on a rolled side (the other side of an open layer "
+                "than the global order), %zu kept it\n",
+                reference ? "from" : "inferred from",
+                reference ? opt->reference.c_str() : opt->input.c_str(), r.rolled_vertices,
+                r.rolled_kept);
         std::printf(
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
             "%.4g\n",

@@ -21,7 +21,7 @@ Run add_slice_command(CLI::App& app);
 /// `strata simplify [IN...] -o OUT [--remove F] [options]`; no input: the demo.
 Run add_simplify_command(CLI::App& app);
 
-/// `strata untangle IN -o OUT [--svg S] [--report R] [options]`.
+/// `strata untangle IN -o OUT [--reference ORIG | --infer-sides] [--svg S] [--report R] [options]`.
 Run add_untangle_command(CLI::App& app);
 
 /// `strata grid IN [-o FIELDS.vdb] [--png FILE [--layer NAME]] [--info]`.

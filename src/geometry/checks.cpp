@@ -886,6 +886,31 @@ InputSides record_input_sides(const Scene& scene, const InputSideParams& params)
     return out;
 }
 
+InputSides InputSides::from_codes(const Scene& scene,
+                                  std::vector<std::vector<signed char>> codes) {
+    auto r = std::make_shared<InputSides::Recorded>();
+    r->scene = scene;
+    const std::size_t n = scene.size();
+    r->n = n;
+    r->memo.resize(n * n);
+    r->indices.resize(n);
+    r->built = std::make_unique<std::once_flag[]>(n);
+    for (std::size_t p = 0; p < n * n && p < codes.size(); ++p) {
+        const std::vector<signed char>& from = codes[p];
+        if (from.empty()) continue;
+        // Every code known: no query is ever made.
+        const std::size_t count = scene.layer(p / n).points.size();
+        auto& found = r->memo[p];
+        found = std::make_unique<std::atomic<signed char>[]>(count);
+        for (std::size_t k = 0; k < count; ++k)
+            found[k].store(k < from.size() ? from[k] : 0, std::memory_order_relaxed);
+    }
+    InputSides out;
+    out.n_ = n;
+    out.recorded_ = std::move(r);
+    return out;
+}
+
 int InputSides::code(std::size_t a, std::size_t k, std::size_t b) const {
     if (a >= n_ || b >= n_ || !recorded_) return 0;
     if (!origin_.empty()) {

@@ -31,6 +31,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <utility>
 
 namespace strata {
@@ -75,6 +76,15 @@ void validate(const SimplifyParams& params) {
                            format_number(params.keep_input_gaps) + ")");
     make_decimator(params.decimator, params.seed);
     validate(params.untangling);
+    // simplify() takes both from its input (record_input_sides(), outside_side()).
+    if (!params.untangling.outside_sides.empty())
+        throw InvalidInput("simplify: params.untangling.outside_sides must be empty (got " +
+                           std::to_string(params.untangling.outside_sides.size()) +
+                           " entries): the input's own are used");
+    if (params.untangling.input_sides)
+        throw InvalidInput(
+            "simplify: params.untangling.input_sides must be null: the sides of the input are "
+            "recorded and kept");
 }
 
 SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const ProgressFn& progress) {

@@ -15,24 +15,59 @@ namespace strata {
 
 namespace {
 
+// Throws InvalidInput when params.outside_sides or params.input_sides do not fit `scene`.
+void validate_sides(const Scene& scene, const UntangleParams& params) {
+    const std::vector<int>& outside = params.outside_sides;
+    if (!outside.empty() && outside.size() != scene.size())
+        throw InvalidInput("untangle: params.outside_sides has " + std::to_string(outside.size()) +
+                           " entries for " + std::to_string(scene.size()) + " layers");
+    for (std::size_t i = 0; i < outside.size(); ++i)
+        if (!scene.layer(i).closed && outside[i] != 1 && outside[i] != -1)
+            throw InvalidInput("untangle: params.outside_sides[" + std::to_string(i) +
+                               "] (layer '" + scene.layer(i).name + "') must be +1 or -1 (got " +
+                               std::to_string(outside[i]) + ")");
+    const InputSides* sides = params.input_sides;
+    if (sides && !sides->empty() && sides->size() != scene.size())
+        throw InvalidInput("untangle: params.input_sides has " + std::to_string(sides->size()) +
+                           " layers for " + std::to_string(scene.size()));
+}
+
+// The rolled vertices of `sides` (as InputSides::rolled_count() counts them) that are not
+// listed among the nesting violations of `check`.
+std::size_t rolled_kept(const Scene& scene, const InputSides& sides,
+                        const std::vector<int>& outside_signs, std::size_t rolled,
+                        const CheckReport& check) {
+    std::size_t lost = 0;
+    for (const NestingViolation& v : check.nesting_violations) {
+        const int side = sides.side(v.layer, v.vertex, v.other);
+        const int wanted = global_side(scene.relation(v.layer, v.other), outside_signs[v.other]);
+        if (side != 0 && wanted != 0 && side != wanted) ++lost;
+    }
+    return rolled - std::min(rolled, lost);
+}
+
 UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const UntangleParams& params,
                    const ProgressFn& progress) {
     validate(params);
+    validate_sides(scene, params);
     UntangleReport report;
     const Scene original = scene;
     try {
         for (const Piece& piece : pieces)
             report.free_vertices +=
                 static_cast<std::size_t>(std::count(piece.is_free.begin(), piece.is_free.end(), 1));
-        // Orientation of open layers from the input, where the nesting is the intended one:
-        // what the untangling pushes toward, and what its checks judge by (a fresh vote on
-        // the result could flip a short layer's outside and call a swapped order clean).
+        // Orientation of open layers from the input, where the nesting is the intended one (or
+        // from params.outside_sides): what the untangling pushes toward, and what its checks
+        // judge by, with the sides given if any (a fresh vote on the result could flip a short
+        // layer's outside and call a swapped order clean).
         detail::EngineSettings settings = detail::resolve_settings(scene, params);
         CheckParams check_params;
         check_params.separation_tolerance = params.separation_tolerance;
         check_params.outside_sides = settings.outside_signs;
         // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
         settings.rest_at_start = true;
+        const bool has_sides = params.input_sides && !params.input_sides->empty();
+        check_params.input_sides = has_sides ? params.input_sides : nullptr;
         CheckReport check = check_scene(scene, check_params);
         report.crossings_before = check.crossing_count;
         auto is_ok = [&](const Scene& s) {
@@ -41,6 +76,12 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         };
         detail::RelationSource relations;
         relations.scene = &original;
+        if (has_sides) {
+            detail::take_input_sides(relations, original, *params.input_sides,
+                                     settings.outside_signs);
+            report.rolled_vertices =
+                params.input_sides->rolled_count(original, settings.outside_signs);
+        }
         const detail::EngineResult r =
             detail::run_engine(scene, pieces, params, relations, settings, is_ok, progress);
         report.passes = r.passes;
@@ -57,6 +98,15 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         report.finish_moves = r.finish_moves;
         report.crossings_after = check.crossing_count;
         report.min_separation_ratio_after = check.min_separation_ratio;
+        if (report.rolled_vertices > 0) {
+            // The last check judged the final scene; list every violation if it did not.
+            if (check.nesting_violations.size() < check.nesting_violation_count) {
+                check_params.max_listed = check.nesting_violation_count;
+                check = check_scene(scene, check_params);
+            }
+            report.rolled_kept = rolled_kept(original, *params.input_sides, settings.outside_signs,
+                                             report.rolled_vertices, check);
+        }
         for (std::size_t l = 0; l < scene.size(); ++l)
             for (std::size_t v = 0; v < scene.layer(l).points.size(); ++v) {
                 const double d =

@@ -4,6 +4,7 @@
 #include "strata/geometry/input_sides.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
+#include "support/fixtures.h"
 
 #include <algorithm>
 #include <cmath>
@@ -147,29 +148,6 @@ TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolle
 
 namespace {
 
-// A rolled scene with waves (the generated family's layers are straight lines, whose collinear
-// removals the driver refuses with or without a roll): inner base y = w(x) on [0, 9], a half
-// circle of radius 1.5 gaps around x = 9, the top back to x = 5 at 3 gaps; the outer layer at
-// 1 gap over [0, 8]; w(x) = 0.3 gap sin 2x. Thickness half the gap (required: half the gap).
-Scene wavy_roll(std::size_t points, double gap_in_segments) {
-    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
-    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
-    Layer inner, outer;
-    inner.name = "inner";
-    outer.name = "outer";
-    inner.thickness = outer.thickness = 0.5 * g;
-    for (double x = 0.0; x <= 8.0 + 1e-9; x += s) outer.points.emplace_back(x, g + w(x));
-    for (double x = 0.0; x < 9.0; x += s) inner.points.emplace_back(x, w(x));
-    const double r = 1.5 * g, pi = 3.14159265358979323846;
-    const int steps = std::max(4, static_cast<int>(std::ceil(pi * r / s)));
-    for (int j = 1; j < steps; ++j) {
-        const double a = -0.5 * pi + pi * j / steps;
-        inner.points.emplace_back(9.0 + r * std::cos(a), r + r * std::sin(a) + w(9.0));
-    }
-    for (double x = 9.0; x >= 5.0; x -= s) inner.points.emplace_back(x, 3.0 * g + w(x));
-    return Scene({inner, outer});
-}
-
 // simplify() on `input` at the given settings: clean, the input's sides kept, gaps >= 0.9 x
 // required, every layer on target, Hausdorff <= 2 x `gap`.
 void check_kept(const Scene& input, double gap, const char* decimator, double remove,
@@ -202,7 +180,7 @@ void check_kept(const Scene& input, double gap, const char* decimator, double re
 
 TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
     for (double gap : {2.0, 4.0}) {
-        const Scene input = wavy_roll(600, gap);
+        const Scene input = test::wavy_roll(600, gap);
         const double g = gap * 10.0 / 599.0;
         const std::vector<int> outside = outside_sides(input);
         const InputSides sides = record_input_sides(input);
@@ -219,73 +197,9 @@ TEST_CASE("a wavy roll meets every target with both schedules", "[rolled]") {
     }
 }
 
-namespace {
-
-// Both layers rolled together, around a centre at (9, 1.5 gaps): the inner layer (base y = 0)
-// takes the outside of the bend (radius 1.5 gaps), the outer one (base y = 1 gap) its inside
-// (radius 0.5 gap); back on top, the inner layer lies over the outer one: the order flips.
-// Same waves as wavy_roll().
-Scene both_rolled(std::size_t points, double gap_in_segments) {
-    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
-    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
-    const double pi = 3.14159265358979323846;
-    Layer inner, outer;
-    inner.name = "inner";
-    outer.name = "outer";
-    inner.thickness = outer.thickness = 0.25 * g;  // required: half a gap, as on the bend
-    auto roll = [&](Layer& layer, double base, double radius) {
-        for (double x = 0.0; x < 9.0; x += s) layer.points.emplace_back(x, base + w(x));
-        const int steps = std::max(4, static_cast<int>(std::ceil(pi * radius / s)));
-        for (int j = 1; j < steps; ++j) {
-            const double a = -0.5 * pi + pi * j / steps;
-            layer.points.emplace_back(9.0 + radius * std::cos(a),
-                                      1.5 * g + radius * std::sin(a) + w(9.0));
-        }
-        for (double x = 9.0; x >= 5.0; x -= s) layer.points.emplace_back(x, 3.0 * g - base + w(x));
-    };
-    roll(inner, 0.0, 1.5 * g);
-    roll(outer, g, 0.5 * g);
-    return Scene({inner, outer});
-}
-
-// A shirt rolled over the end of a jacket, both over a closed body: body radius 1 (closed,
-// under the shirt), shirt at 1 + gap over angles [0.5, 5], jacket at 1 + 2 gaps over
-// [0.5, 5 - 4 gaps]; at angle 5 the shirt turns outward around a half circle of radius 1 gap
-// and comes back at 1 + 3 gaps (over the jacket) to angle 4.
-Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments) {
-    const double s = 2.0 * 3.14159265358979323846 / static_cast<double>(points);
-    const double g = gap_in_segments * s, pi = 3.14159265358979323846;
-    auto at = [](double r, double t) { return Vec2(r * std::cos(t), r * std::sin(t)); };
-    Layer body, shirt, jacket;
-    body.name = "body";
-    shirt.name = "shirt";
-    jacket.name = "jacket";
-    body.closed = true;
-    body.thickness = shirt.thickness = jacket.thickness = 0.5 * g;
-    body.outer = std::vector<std::string>{"shirt"};
-    shirt.outer = std::vector<std::string>{"jacket"};
-    jacket.outer = std::vector<std::string>{};
-    for (std::size_t i = 0; i < points; ++i)
-        body.points.push_back(at(1.0, s * static_cast<double>(i)));
-    for (double t = 0.5; t <= 5.0 - 4.0 * g + 1e-12; t += s)
-        jacket.points.push_back(at(1.0 + 2.0 * g, t));
-    for (double t = 0.5; t < 5.0; t += s) shirt.points.push_back(at(1.0 + g, t));
-    const int steps = std::max(4, static_cast<int>(std::ceil(pi * g / s)));
-    const Vec2 centre = at(1.0 + 2.0 * g, 5.0), radial = at(1.0, 5.0),
-               along = at(1.0, 5.0 + 0.5 * pi);
-    for (int j = 0; j <= steps; ++j) {  // from radius 1 + g to 1 + 3 g, bulging forward
-        const double a = pi * j / steps;
-        shirt.points.push_back(centre - g * std::cos(a) * radial + g * std::sin(a) * along);
-    }
-    for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * g, t));
-    return Scene({body, shirt, jacket});
-}
-
-}  // namespace
-
 TEST_CASE("both layers rolled together, and a shirt rolled over a jacket on a body", "[rolled]") {
-    const Scene together = both_rolled(600, 4.0);
-    const Scene shirt = shirt_rolled_over_jacket(600, 4.0);
+    const Scene together = test::both_rolled(600, 4.0);
+    const Scene shirt = test::shirt_rolled_over_jacket(600, 4.0);
     {
         const CheckReport in = check_scene(together);
         REQUIRE(in.crossing_count == 0);

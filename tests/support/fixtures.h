@@ -29,6 +29,27 @@ Scene touching_pair();
 /// One open Archimedean spiral r = 0.1 + 0.1 * angle / (2 pi) over `turns` turns.
 Scene spiral(double turns, std::size_t points);
 
+/// Two open layers, the inner one rolled over the end of the outer one, with waves (the
+/// generated `rolled` family's layers are straight lines, whose collinear removals the
+/// simplification refuses with or without a roll): inner base y = w(x) on [0, 9], a half
+/// circle of radius 1.5 gaps around x = 9, the top back to x = 5 at 3 gaps; the outer layer at
+/// 1 gap over [0, 8]; w(x) = 0.3 gap sin 2x; gap = gap_in_segments x 10 / (points - 1).
+/// Thickness half the gap (required separation: half the gap).
+Scene wavy_roll(std::size_t points, double gap_in_segments);
+
+/// Both layers rolled together around a centre at (9, 1.5 gaps): the inner layer (base y = 0)
+/// takes the outside of the bend (radius 1.5 gaps), the outer one (base y = 1 gap) its inside
+/// (radius 0.5 gap); back on top, the inner layer lies over the outer one: the order flips.
+/// Same waves and gap as wavy_roll(); thickness a quarter gap.
+Scene both_rolled(std::size_t points, double gap_in_segments);
+
+/// A shirt rolled over the end of a jacket, both over a closed body: body radius 1 (closed,
+/// `points` vertices, under the shirt), shirt at 1 + gap over angles [0.5, 5], jacket at
+/// 1 + 2 gaps over [0.5, 5 - 4 gaps]; at angle 5 the shirt turns outward around a half circle
+/// of radius 1 gap and comes back at 1 + 3 gaps (over the jacket) to angle 4. Gap =
+/// gap_in_segments x 2 pi / points; thickness half the gap.
+Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments);
+
 /// tests/data/<name>
 std::filesystem::path test_data(const std::string& name);
 /// ../shared/data/<name> beside the project, or empty when that folder is absent.

@@ -64,6 +64,13 @@ class InputSides {
     /// none. Defined in checks.cpp (nearest queries).
     static InputSides matched(const InputSides& recorded, const Scene& reference,
                               const Scene& scene);
+    /// The same sides made consistent along each layer, for sides recorded in a scene that is
+    /// itself tangled (`scene`, the one recorded): the vertices of layer a with a side of open
+    /// layer b fall into regions, runs of consecutive vertices joined by a segment that keeps
+    /// its side or crosses b (a tangle: one end is on the wrong side); a segment that changes
+    /// side without meeting b goes around b's end and starts another region (a roll). Every
+    /// vertex of a region takes the side of the majority of its vertices (a tie: no side).
+    InputSides by_region(const Scene& scene) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
     /// outside_side() per layer of `scene`, the scene these sides are for): the rolled or
     /// folded-over vertices, once per other layer. Finds the side of every vertex.
@@ -77,6 +84,9 @@ class InputSides {
     int code(std::size_t a, std::size_t k, std::size_t b) const;
     /// Vertices of layer a of the scene these sides are for.
     std::size_t vertex_count(std::size_t a) const;
+    /// Sides for `scene` given as codes: codes[a * n + b][k] for vertex k of layer a against
+    /// layer b (empty: none). Defined in checks.cpp.
+    static InputSides from_codes(const Scene& scene, std::vector<std::vector<signed char>> codes);
     friend InputSides record_input_sides(const Scene&, const InputSideParams&);
 
     static constexpr std::size_t kNoLayer = static_cast<std::size_t>(-1);
@@ -94,6 +104,12 @@ class InputSides {
 /// side is found when first asked for (see InputSides).
 /// @throws InvalidInput bad params.
 InputSides record_input_sides(const Scene& scene, const InputSideParams& params = {});
+
+/// @brief Sides inferred from a tangled scene alone (no original at hand):
+/// record_input_sides(scene, params).by_region(scene). A rolled part, a whole region on the
+/// other side of an open layer, keeps that side; a vertex that a tangle put on the wrong side
+/// takes its region's. @throws InvalidInput bad params.
+InputSides infer_input_sides(const Scene& scene, const InputSideParams& params = {});
 
 /// The side rule of check_scene() where the closest point of a polyline to `v` is the corner
 /// `w` between its segments (u, w) and (w, x): +1 right of the direction of travel, -1 left.

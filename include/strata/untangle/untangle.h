@@ -6,6 +6,7 @@
 
 #include "strata/core/progress.h"
 #include "strata/field/field.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/geometry/scene.h"
 #include "strata/untangle/composition.h"
 #include "strata/untangle/localize.h"
@@ -81,6 +82,22 @@ struct UntangleParams {
     /// queries as fast (docs/field.md, README "Benchmarks").
     FieldParams field = {FieldBackend::ExactIndexed};
     CompositionParams composition;  ///< Composition solver settings.
+    /// Outside sides of the open layers (+1 or -1 per layer, see outside_side(); entries of
+    /// closed layers are ignored), e.g. those of the original a decimated scene comes from:
+    /// they orient the open layers' fields and say which side of them is "over". Empty:
+    /// outside_side() of the scene being untangled. simplify() takes its input's (leave empty).
+    std::vector<int> outside_sides;
+    /// Sides to keep, recorded in the scene the untangled one comes from (record_input_sides())
+    /// and carried onto its vertices (InputSides::renumbered(), or InputSides::matched() when
+    /// the vertex correspondence is not known), or nullptr. Where a vertex has a recorded side
+    /// of an open layer under or over its own that is not the global order's (a rolled or
+    /// folded-over part), the untangling keeps it there: the composition takes that layer's
+    /// field with its sign changed, the finishing stage pushes the vertex toward that side, and
+    /// the final check judges nesting against the recorded sides (CheckParams::input_sides);
+    /// around an end of that layer only the distance counts. Elsewhere the global order
+    /// decides, as without it. Not owned; must outlive the call. simplify() records its own
+    /// input's (leave nullptr).
+    const InputSides* input_sides = nullptr;
 };
 
 /// Throws InvalidInput naming the first out-of-range field.
@@ -104,12 +121,19 @@ struct UntangleReport {
     std::size_t finish_moves = 0;  ///< Vertex moves the finishing stage made.
     double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
     double seconds_finish = 0.0;  ///< Time in the finishing stage.
+    /// With params.input_sides: vertices whose recorded side of an open layer is not the one
+    /// the global order gives (rolled or folded over; once per other layer, as
+    /// InputSides::rolled_count()), and of those, the ones still on that side at the end (not a
+    /// nesting violation of the final check).
+    std::size_t rolled_vertices = 0, rolled_kept = 0;
 };
 
-/// @brief Untangles the whole scene (the global mode): every vertex may move.
+/// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
+/// global order, except where params.input_sides gives a vertex another side.
 /// @param scene     modified in place; unchanged on throw.
 /// @param progress  called once per round ("untangle", fraction); false cancels (throws Cancelled).
-/// @throws InvalidInput bad params.  @throws Cancelled.
+/// @throws InvalidInput bad params, or params.outside_sides / params.input_sides not of the
+/// scene's layer count.  @throws Cancelled.
 UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
                         const ProgressFn& progress = {});
 

@@ -187,37 +187,12 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
     return Prepared::Ready;
 }
 
-// The local sides of the job's vertices (RelationSource::local_sides): a vertex whose input
-// side of an open layer under or over its own is not the global order's keeps it in the job's
-// untangling, and one around an end of that layer keeps its distance on any side. Nothing is
-// set when the job has no such vertex.
+// The local sides of the job's vertices (RelationSource::local_sides, take_input_sides()):
+// vertex k of run r is input vertex run.ids[k] of layer run.layer. Nothing is set when the
+// job has no such vertex.
 void JobRunner::local_sides(Job& job) const {
-    if (sides_.empty()) return;
-    const std::size_t runs = job.runs.size();
-    for (std::size_t r = 0; r < runs; ++r) {
-        const Run& run = job.runs[r];
-        for (std::size_t r2 = 0; r2 < runs; ++r2) {
-            const std::size_t other = job.runs[r2].layer;
-            if (other == run.layer || input_.layer(other).closed) continue;
-            const int wanted =
-                global_side(input_.relation(run.layer, other), settings_.outside_signs[other]);
-            if (wanted == 0) continue;
-            for (std::size_t k = 0; k < run.ids.size(); ++k) {
-                const std::size_t id = run.ids[k];
-                const int side = sides_.side(run.layer, id, other);
-                RelationSource::Side how = RelationSource::Side::Global;
-                if (sides_.beyond_end(run.layer, id, other))
-                    how = RelationSource::Side::AnySide;
-                else if (side != 0 && side != wanted)
-                    how = RelationSource::Side::Flipped;
-                if (how == RelationSource::Side::Global) continue;
-                auto& all = job.relations.local_sides;
-                if (all.empty()) all.resize(runs);
-                if (all[r].empty()) all[r].resize(run.ids.size());
-                all[r][k].push_back({r2, how});
-            }
-        }
-    }
+    take_input_sides(job.relations, *job.work, sides_, settings_.outside_signs,
+                     [&job](std::size_t r, std::size_t k) { return job.runs[r].ids[k]; });
 }
 
 void JobRunner::execute(Job& job) const {

@@ -543,6 +543,38 @@ bool is_stalled(const std::vector<double>& worst, int passes, double allowed) {
 
 }  // namespace
 
+void take_input_sides(RelationSource& relations, const Scene& work, const InputSides& sides,
+                      const std::vector<int>& outside_signs,
+                      const std::function<std::size_t(std::size_t, std::size_t)>& id_of) {
+    if (sides.empty()) return;
+    const Scene& input = *relations.scene;
+    const std::size_t n = work.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t layer = relations.of(i);
+        for (std::size_t j = 0; j < n; ++j) {
+            const std::size_t other = relations.of(j);
+            if (other == layer || input.layer(other).closed) continue;
+            const int wanted = global_side(input.relation(layer, other), outside_signs[other]);
+            if (wanted == 0) continue;
+            const std::size_t count = work.layer(i).points.size();
+            for (std::size_t k = 0; k < count; ++k) {
+                const std::size_t id = id_of ? id_of(i, k) : k;
+                const int side = sides.side(layer, id, other);
+                RelationSource::Side how = RelationSource::Side::Global;
+                if (sides.beyond_end(layer, id, other))
+                    how = RelationSource::Side::AnySide;
+                else if (side != 0 && side != wanted)
+                    how = RelationSource::Side::Flipped;
+                if (how == RelationSource::Side::Global) continue;
+                auto& all = relations.local_sides;
+                if (all.empty()) all.resize(n);
+                if (all[i].empty()) all[i].resize(count);
+                all[i][k].push_back({j, how});
+            }
+        }
+    }
+}
+
 EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params) {
     EngineSettings settings;
     settings.min_separation =
@@ -553,7 +585,9 @@ EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params
     settings.diagonal = std::max(std::hypot(size.x, size.y), std::numeric_limits<double>::min());
     settings.outside_signs.resize(scene.size());
     for (std::size_t i = 0; i < scene.size(); ++i)
-        settings.outside_signs[i] = outside_side(scene, i);
+        settings.outside_signs[i] = i < params.outside_sides.size() && !scene.layer(i).closed
+                                        ? params.outside_sides[i]
+                                        : outside_side(scene, i);
     return settings;
 }
 

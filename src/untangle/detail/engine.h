@@ -3,6 +3,7 @@
 /// projection + shape matching over fields built from a work scene whose layers may stand for
 /// layers (or parts of layers) of another scene.
 
+#include "strata/geometry/input_sides.h"
 #include "strata/untangle/untangle.h"
 
 #include <functional>
@@ -57,6 +58,18 @@ struct RelationSource {
     }
 };
 
+/// Sets relations.local_sides from sides recorded in relations.scene (input_sides.h): a vertex
+/// whose recorded side of an open layer under or over its own is not the one the global order
+/// gives (`outside_signs`: outside_side() of every layer of relations.scene) takes that layer's
+/// work layers on its own side (Flipped), and a vertex around an end of that layer keeps its
+/// distance on any side (AnySide). Vertex k of work layer i is vertex id_of(i, k) of layer
+/// relations.of(i) (empty id_of: k itself); `work` gives the work layers' vertex counts.
+/// Nothing is set when no vertex has such a side (local_sides stays empty). Shared by
+/// untangle() (the whole scene) and the simplification driver (a job's runs).
+void take_input_sides(RelationSource& relations, const Scene& work, const InputSides& sides,
+                      const std::vector<int>& outside_signs,
+                      const std::function<std::size_t(std::size_t, std::size_t)>& id_of = {});
+
 /// Scene-wide settings of the engine, resolved once.
 struct EngineSettings {
     double min_separation = 0.0;     ///< Resolved UntangleParams::min_separation (> 0).
@@ -86,7 +99,8 @@ struct EngineResult {
     double seconds_finish = 0.0;
 };
 
-/// Resolves the automatic min_separation and sample_spacing from `scene` and the params.
+/// Resolves the automatic min_separation and sample_spacing from `scene` and the params, and
+/// the outside signs (params.outside_sides where given, else outside_side() of `scene`).
 EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params);
 
 /// Runs passes (fields built from `work` at the start of each) until is_ok(work) holds or

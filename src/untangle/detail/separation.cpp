@@ -41,9 +41,7 @@ class SegmentCells {
         return n < 2 ? 0 : closed_[l] ? n : n - 1;
     }
     Vec2 start(const SegId& s) const { return pts_[s.layer][s.index]; }
-    Vec2 end(const SegId& s) const {
-        return pts_[s.layer][(s.index + 1) % pts_[s.layer].size()];
-    }
+    Vec2 end(const SegId& s) const { return pts_[s.layer][(s.index + 1) % pts_[s.layer].size()]; }
 
     // Vertex (l, v) has moved (pts was updated).
     void moved(std::size_t l, std::size_t v) {
@@ -92,8 +90,8 @@ class SegmentCells {
             const SegId s{static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)};
             const Vec2 a = start(s), b = end(s);
             for (std::size_t iy = row(std::min(a.y, b.y)); iy <= row(std::max(a.y, b.y)); ++iy)
-                for (std::size_t ix = column(std::min(a.x, b.x));
-                     ix <= column(std::max(a.x, b.x)); ++ix)
+                for (std::size_t ix = column(std::min(a.x, b.x)); ix <= column(std::max(a.x, b.x));
+                     ++ix)
                     g(iy * nx_ + ix, s);
         };
         for (std::size_t l = 0; l < pts_.size(); ++l)
@@ -124,10 +122,10 @@ class SegmentCells {
 
     const std::vector<std::vector<Vec2>>& pts_;
     const std::vector<char>& closed_;
-    double cell_;         // the cell size asked for
-    Box2 region_;         // where queries are made
-    double step_ = 1.0;   // the cell size built
-    Box2 origin_;         // the bounds at the build
+    double cell_;        // the cell size asked for
+    Box2 region_;        // where queries are made
+    double step_ = 1.0;  // the cell size built
+    Box2 origin_;        // the bounds at the build
     std::size_t nx_ = 1, ny_ = 1;
     std::vector<std::uint32_t> start_, fill_;  // per cell, into ids_
     std::vector<SegId> ids_;
@@ -203,7 +201,8 @@ class Finisher {
         for (std::size_t l = 0; l < pts_.size(); ++l)
             for (std::size_t v = 0; v < pts_[l].size(); ++v)
                 if (region.contains(pts_[l][v]))
-                    active_.push_back({static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(v)});
+                    active_.push_back(
+                        {static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(v)});
         cells_.emplace(pts_, closed_, cell, region);
         std::vector<bool> changed(pts_.size(), false);
         // A close vertex on the wrong side of another layer is a tangle the projection has to
@@ -290,8 +289,11 @@ class Finisher {
             const SegId& s = found_[x.index];
             const Vec2 q0 = cells_->start(s), q1 = cells_->end(s), p = pts_[l][v];
             int wanted = wanted_side(l, v, s.layer);
-            // No side asked of an open layer: the side the rest of the vertex's run is on.
-            if (wanted == 0 && !closed_[s.layer] && x.distance < tangle_reach_)
+            // No side asked of an open side-by-side layer: the side the rest of the vertex's
+            // run is on. (Not where a local side asks for any side around an end: a roll's
+            // bend is there, which this would push back.)
+            if (wanted == 0 && !closed_[s.layer] && x.distance < tangle_reach_ &&
+                relation_[l * pts_.size() + s.layer] == Relation::SideBySide)
                 wanted = poke_side(l, v, q0, q1);
             x.wanted = wanted;
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
@@ -316,7 +318,7 @@ class Finisher {
             const double t = e2 > 0.0 ? std::clamp(glm::dot(p - q0, e) / e2, 0.0, 1.0) : 0.0;
             Vec2 normal;
             double shortfall = aim - d;
-            if (near.is_wrong) {  // over to the side it belongs on, at the aim
+            if (near.is_wrong) {             // over to the side it belongs on, at the aim
                 const Vec2 left(-e.y, e.x);  // orient2d(q0, q1, q0 + left) = +1
                 normal = static_cast<double>(near.wanted) * left / std::sqrt(e2);
                 shortfall = aim + d;
@@ -370,7 +372,7 @@ class Finisher {
         }
     }
 
-    // Where no side is asked for (side-by-side layers, any side): the side of segment
+    // Where no side is asked of an open side-by-side layer: the side of segment
     // (q0, q1) of another layer that vertex (l, v) pokes through from. Walking along layer l
     // from v both ways (at most kPokeRun segments each), the first segments that properly
     // cross (q0, q1) bound a run of l that lies on the other side of it than the rest of the

@@ -8,8 +8,8 @@
 /// aimed for, by projected Gauss-Seidel on point-segment distance constraints (Müller et al.
 /// 2007, position-based dynamics), weighted by the layer weights. A vertex is pushed only when
 /// it lies on the side of the other layer that the nesting asks for (the composition's side);
-/// one on the wrong side is left to the projection. Where no side is asked of an open layer
-/// (side by side, or any side around its end), a vertex whose run of its layer pokes through
+/// one on the wrong side is left to the projection. Where no side is asked of an open
+/// side-by-side layer, a vertex whose run of its layer pokes through
 /// it (bounded by two segments that cross the same segment of it, or by one and an end of
 /// its own open layer) belongs on the side of the rest of its layer. Every move is validated
 /// exactly before it is made: the moved vertex's two new segments meet no other segment and
