@@ -59,6 +59,7 @@ struct Totals {
     std::size_t failures = 0, thread_mismatches = 0;
     std::size_t crossings = 0, self_crossings = 0, nesting = 0, separation_violations = 0;
     std::size_t refused = 0, untangle_calls = 0, removed = 0, targets_missed = 0;
+    std::size_t restored_runs = 0, restored_vertices = 0;  // simplify()'s last resort
     std::size_t errors = 0;  // simplify() threw InvalidInput on a valid scene: no output
     std::map<std::string, std::array<std::size_t, 3>> per_family;  // scenes, runs, failing
     double min_ratio = std::numeric_limits<double>::infinity();
@@ -245,6 +246,8 @@ int main(int argc, char** argv) {
                         t.untangle_calls += report.untangle_calls;
                         t.removed += report.removed;
                         if (!report.targets_met) ++t.targets_missed;
+                        if (report.restored > 0) ++t.restored_runs;
+                        t.restored_vertices += report.restored;
                     }
                     const bool ok =
                         r.is_collision_free() && r.separations_hold() && report.collision_free;
@@ -295,11 +298,12 @@ int main(int argc, char** argv) {
         "stress_guarantee: seed %llu, %zu scenes (%zu generated inputs skipped), %zu runs, %zu "
         "outputs checked: %zu failing, %zu thread mismatches; crossings %zu, self-crossings %zu, "
         "nesting violations %zu, separation violations %zu, min gap/required %.4g; removals %zu "
-        "kept, %zu refused, %zu local untanglings, %zu runs short of target; %.1f s\n",
+        "kept, %zu refused, %zu local untanglings, %zu runs short of target, %zu runs (1 "
+        "thread) needed the last resort (%zu vertices restored); %.1f s\n",
         static_cast<unsigned long long>(opt.seed), t.scenes, t.skipped_inputs, t.runs,
         t.outputs_checked, t.failures, t.thread_mismatches, t.crossings, t.self_crossings,
         t.nesting, t.separation_violations, t.min_ratio, t.removed, t.refused, t.untangle_calls,
-        t.targets_missed, seconds);
+        t.targets_missed, t.restored_runs, t.restored_vertices, seconds);
     for (const auto& [name, f] : t.per_family)
         std::printf("  %-7s %5zu scenes %6zu runs %5zu failing\n", name.c_str(), f[0], f[1], f[2]);
     if (t.errors)
