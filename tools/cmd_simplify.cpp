@@ -244,10 +244,14 @@ Run add_simplify_command(CLI::App& app) {
         if (untangled)
             std::printf(
                 "%s: the input crossed (%zu crossings, %zu nesting violations): untangled first "
-                "(%zu vertices moved, at most %.4g; gap ratio %.4g; %d passes)\n",
+                "(%zu vertices moved, at most %.4g; gap ratio %.4g; %d passes%s)\n",
                 name.c_str(), untangled->crossings, untangled->nesting_violations,
                 untangled->report.moved_vertices, untangled->report.max_displacement,
-                untangled->report.min_separation_ratio_after, untangled->report.passes);
+                untangled->report.min_separation_ratio_after, untangled->report.passes,
+                untangled->inferred_sides
+                    ? "; the sides of open layers inferred per region of the input, as "
+                      "'strata untangle --infer-sides'"
+                    : "");
         Scene result, naive;
         const Outcome out = run_one(*prepared, o, terminal_progress(), result, &naive);
         write_scene(result, o.output);

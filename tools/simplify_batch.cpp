@@ -6,6 +6,7 @@
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/io/atomic_file.h"
 #include "strata/io/scene_io.h"
 
@@ -167,7 +168,30 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
     info.crossings = before.crossing_count;
     info.nesting_violations = before.nesting_violation_count;
     info.report = untangle(scene, u);
-    const CheckReport after = check_scene(scene);
+    CheckReport after = check_scene(scene);
+    if (!after.is_collision_free() && after.crossing_count == 0 &&
+        after.total_self_crossings() == 0) {
+        // Only sides left: a part folded or rolled over an open layer, which the global order
+        // pushes back. Again from the input, with the sides inferred per region of it
+        // (`strata untangle --infer-sides`): a rolled part stays rolled.
+        Scene again = input;
+        const InputSides inferred = infer_input_sides(input);
+        UntangleParams v = u;
+        v.outside_sides.clear();
+        for (std::size_t l = 0; l < input.size(); ++l)
+            v.outside_sides.push_back(outside_side(input, l));
+        v.input_sides = &inferred;
+        const UntangleReport report = untangle(again, v);
+        CheckParams cp;
+        cp.outside_sides = v.outside_sides;
+        cp.input_sides = &inferred;  // untangling keeps the vertex indices
+        if (report.collision_free && check_scene(again, cp).is_collision_free()) {
+            scene = std::move(again);
+            info.report = report;
+            info.inferred_sides = true;
+            after = check_scene(scene, cp);
+        }
+    }
     if (!after.is_collision_free())
         throw InvalidInput(name + ": the input is not collision-free (" + what +
                            ") and untangling it left " + tangle_summary(scene, after) +
@@ -183,6 +207,7 @@ nlohmann::json untangling_json(const InputUntangling& u) {
             {"max_displacement", u.report.max_displacement},
             {"min_separation_ratio_after", finite_or_null(u.report.min_separation_ratio_after)},
             {"passes", u.report.passes},
+            {"sides", u.inferred_sides ? "inferred" : "global"},
             {"seconds", u.report.seconds_fields + u.report.seconds_untangle +
                             u.report.seconds_finish + u.report.seconds_check}};
 }

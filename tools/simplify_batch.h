@@ -39,6 +39,9 @@ struct SimplifyOptions {
 struct InputUntangling {
     std::size_t crossings = 0, nesting_violations = 0;  ///< Of the input.
     UntangleReport report;
+    /// The global order left only sides: the untangling that passed kept the sides inferred
+    /// per region of the input (infer_input_sides()).
+    bool inferred_sides = false;
 };
 
 /// The outcome of one scene (one slice of a batch).
