@@ -6,6 +6,7 @@
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/input_gaps.h"
 #include "strata/geometry/input_sides.h"
 #include "strata/io/atomic_file.h"
 #include "strata/io/scene_io.h"
@@ -131,6 +132,38 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
     return text;
 }
 
+// The untangling of a crossing input, from `start` (the input, perhaps with raised
+// separations): the global order, and where that leaves only sides (a part folded or rolled
+// over an open layer, which the global order pushes back) again with the sides inferred per
+// region of the input (`strata untangle --infer-sides`), so that a rolled part stays rolled.
+// `after`: the check of the result (against the inferred sides when they were taken).
+Scene untangle_input(const Scene& start, const Scene& input, const UntangleParams& u,
+                     InputUntangling& info, CheckReport& after) {
+    Scene scene = start;
+    info.report = untangle(scene, u);
+    info.inferred_sides = false;
+    after = check_scene(scene);
+    if (after.is_collision_free() || after.crossing_count > 0 || after.total_self_crossings() > 0)
+        return scene;
+    Scene again = start;
+    const InputSides inferred = infer_input_sides(input);
+    UntangleParams v = u;
+    v.outside_sides.clear();
+    for (std::size_t l = 0; l < input.size(); ++l)
+        v.outside_sides.push_back(outside_side(input, l));
+    v.input_sides = &inferred;
+    const UntangleReport report = untangle(again, v);
+    CheckParams cp;
+    cp.outside_sides = v.outside_sides;
+    cp.input_sides = &inferred;  // untangling keeps the vertex indices
+    const CheckReport checked = check_scene(again, cp);
+    if (!report.collision_free || !checked.is_collision_free()) return scene;
+    info.report = report;
+    info.inferred_sides = true;
+    after = checked;
+    return again;
+}
+
 std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
                                    const SimplifyParams& params,
                                    std::optional<InputUntangling>& untangled) {
@@ -155,7 +188,6 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
                            (mode == InputCrossings::Fail
                                 ? "; not simplified (--input-crossings untangle mends it first)"
                                 : "; a layer that crosses itself cannot be untangled"));
-    Scene scene = input;
     UntangleParams u = params.untangling;
     // The global untangling's own pass structure (untangle()'s defaults), the driver's field
     // and shape settings.
@@ -167,30 +199,24 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
     InputUntangling info;
     info.crossings = before.crossing_count;
     info.nesting_violations = before.nesting_violation_count;
-    info.report = untangle(scene, u);
-    CheckReport after = check_scene(scene);
-    if (!after.is_collision_free() && after.crossing_count == 0 &&
-        after.total_self_crossings() == 0) {
-        // Only sides left: a part folded or rolled over an open layer, which the global order
-        // pushes back. Again from the input, with the sides inferred per region of it
-        // (`strata untangle --infer-sides`): a rolled part stays rolled.
-        Scene again = input;
-        const InputSides inferred = infer_input_sides(input);
-        UntangleParams v = u;
-        v.outside_sides.clear();
-        for (std::size_t l = 0; l < input.size(); ++l)
-            v.outside_sides.push_back(outside_side(input, l));
-        v.input_sides = &inferred;
-        const UntangleReport report = untangle(again, v);
-        CheckParams cp;
-        cp.outside_sides = v.outside_sides;
-        cp.input_sides = &inferred;  // untangling keeps the vertex indices
-        if (report.collision_free && check_scene(again, cp).is_collision_free()) {
-            scene = std::move(again);
-            info.report = report;
-            info.inferred_sides = true;
-            after = check_scene(scene, cp);
-        }
+    // The gap rule first, on the input as read: the pairs that do not cross keep their share
+    // of the gaps they have there through the untangling too (simplify() measures no gap
+    // again for a pair with a required separation). Without it when the untangling then
+    // fails (the gaps can ask for more room than a tangled region has).
+    std::vector<Scene> starts;
+    if (params.untangle && params.keep_input_gaps > 0.0) {
+        Scene gapped = input;
+        InputGapParams gap_params;
+        gap_params.fraction =
+            std::min(1.0, params.keep_input_gaps / (1.0 - params.untangling.separation_tolerance));
+        if (keep_input_gaps(gapped, gap_params).raised > 0) starts.push_back(std::move(gapped));
+    }
+    starts.push_back(input);
+    Scene scene;
+    CheckReport after;
+    for (const Scene& start : starts) {
+        scene = untangle_input(start, input, u, info, after);
+        if (after.is_collision_free()) break;
     }
     if (!after.is_collision_free())
         throw InvalidInput(name + ": the input is not collision-free (" + what +
