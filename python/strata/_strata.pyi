@@ -118,6 +118,8 @@ class SimplifyReport:
     batches: int
     targets_met: bool
     raised_separations: int
+    rolled_vertices: int  #: Output vertices kept on a rolled side, as in the input.
+    restored: int  #: Input vertices put back by the last resort (the whole-result check failed).
     crossings: int  #: Final exact check of the output: crossings between layers.
     self_crossings: int
     nesting_violations: int

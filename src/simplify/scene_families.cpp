@@ -128,6 +128,76 @@ std::vector<Layer> rolled(const FamilyParams& p) {
     return {inner, outer};
 }
 
+// Rolled twice: as Rolled, then the inner layer's top turns up again at x = 5, half a turn of
+// radius gap, and runs forward at y = 5 gap to x = 8: a cuff turned back twice over the end of
+// the outer layer.
+std::vector<Layer> rolled_twice(const FamilyParams& p) {
+    std::vector<Layer> layers = rolled(p);
+    const double s = 10.0 / static_cast<double>(p.points - 1), gap = p.gap * s;
+    Layer& inner = layers[0];
+    const Vec2 end = inner.points.back();  // about (5, 3 gap)
+    const int steps = std::max(4, static_cast<int>(std::ceil(kPi * gap / s)));
+    for (int j = 1; j <= steps; ++j) {
+        const double a = -0.5 * kPi - kPi * j / steps;  // around (x_end, 4 gap), on the left
+        inner.points.emplace_back(end.x + gap * std::cos(a), 4.0 * gap + gap * std::sin(a));
+    }
+    for (double x = end.x + s; x <= 8.0 + 1e-9; x += s) inner.points.emplace_back(x, 5.0 * gap);
+    return layers;
+}
+
+// Both rolled: the two layers of Rolled rolled together around (9, 1.5 gap), with waves
+// w(x) = 0.3 gap sin 2x: the inner layer (base y = 0) takes the outside of the bend (radius
+// 1.5 gap), the outer one (base y = gap) its inside (radius 0.5 gap); back on top, to x = 5,
+// the inner layer lies over the outer one: the order flips. Thickness a quarter gap (the
+// required separation, half a gap, is what the bend leaves).
+std::vector<Layer> rolled_both(const FamilyParams& p) {
+    const double s = 10.0 / static_cast<double>(p.points - 1), gap = p.gap * s;
+    auto w = [gap](double x) { return 0.3 * gap * std::sin(2.0 * x); };
+    Layer inner = make_layer("inner", 0.25 * gap), outer = make_layer("outer", 0.25 * gap);
+    auto roll = [&](Layer& layer, double base, double radius) {
+        for (double x = 0.0; x < 9.0; x += s) layer.points.emplace_back(x, base + w(x));
+        const int steps = std::max(4, static_cast<int>(std::ceil(kPi * radius / s)));
+        for (int j = 1; j < steps; ++j) {
+            const double a = -0.5 * kPi + kPi * j / steps;
+            layer.points.emplace_back(9.0 + radius * std::cos(a),
+                                      1.5 * gap + radius * std::sin(a) + w(9.0));
+        }
+        for (double x = 9.0; x >= 5.0; x -= s)
+            layer.points.emplace_back(x, 3.0 * gap - base + w(x));
+    };
+    roll(inner, 0.0, 1.5 * gap);
+    roll(outer, gap, 0.5 * gap);
+    return {inner, outer};
+}
+
+// Shirt roll: a shirt rolled over the end of a jacket, both over a closed body. Body radius 1
+// (`points` vertices, under the shirt), shirt at 1 + gap over the angles [0.5, 5], jacket at
+// 1 + 2 gap over [0.5, 5 - 4 gap]; at angle 5 the shirt turns outward around a half circle of
+// radius gap and comes back at 1 + 3 gap (over the jacket) to angle 4.
+std::vector<Layer> shirt_roll(const FamilyParams& p) {
+    const double s = 2.0 * kPi / static_cast<double>(p.points), gap = p.gap * s;
+    auto at = [](double r, double t) { return Vec2(r * std::cos(t), r * std::sin(t)); };
+    Layer body = make_layer("body", 0.5 * gap, true), shirt = make_layer("shirt", 0.5 * gap),
+          coat = make_layer("jacket", 0.5 * gap);
+    body.outer = std::vector<std::string>{"shirt"};
+    shirt.outer = std::vector<std::string>{"jacket"};
+    coat.outer = std::vector<std::string>{};
+    for (std::size_t i = 0; i < p.points; ++i)
+        body.points.push_back(at(1.0, s * static_cast<double>(i)));
+    for (double t = 0.5; t <= 5.0 - 4.0 * gap + 1e-12; t += s)
+        coat.points.push_back(at(1.0 + 2.0 * gap, t));
+    for (double t = 0.5; t < 5.0; t += s) shirt.points.push_back(at(1.0 + gap, t));
+    const int steps = std::max(4, static_cast<int>(std::ceil(kPi * gap / s)));
+    const Vec2 centre = at(1.0 + 2.0 * gap, 5.0), radial = at(1.0, 5.0),
+               along = at(1.0, 5.0 + 0.5 * kPi);
+    for (int j = 0; j <= steps; ++j) {  // from radius 1 + gap to 1 + 3 gap, bulging forward
+        const double a = kPi * j / steps;
+        shirt.points.push_back(centre - gap * std::cos(a) * radial + gap * std::sin(a) * along);
+    }
+    for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * gap, t));
+    return {body, shirt, coat};
+}
+
 // Jacket: a body loop r = 1 + 0.02 sin 5t and, gap outside it, an open jacket over the
 // angles [pi/4, 7 pi/4] with the same waves; the body's `outer` is the jacket.
 std::vector<Layer> jacket(const FamilyParams& p) {
@@ -192,8 +262,9 @@ std::vector<Layer> legs(const FamilyParams& p) {
 }  // namespace
 
 std::vector<SceneFamily> all_scene_families() {
-    return {SceneFamily::Stack,  SceneFamily::Loops,  SceneFamily::Folded,
-            SceneFamily::Rolled, SceneFamily::Jacket, SceneFamily::Legs};
+    return {SceneFamily::Stack,       SceneFamily::Loops,      SceneFamily::Folded,
+            SceneFamily::Rolled,      SceneFamily::Jacket,     SceneFamily::Legs,
+            SceneFamily::RolledTwice, SceneFamily::RolledBoth, SceneFamily::ShirtRoll};
 }
 
 std::string family_name(SceneFamily family) {
@@ -210,8 +281,21 @@ std::string family_name(SceneFamily family) {
             return "jacket";
         case SceneFamily::Legs:
             return "legs";
+        case SceneFamily::RolledTwice:
+            return "rolled_twice";
+        case SceneFamily::RolledBoth:
+            return "rolled_both";
+        case SceneFamily::ShirtRoll:
+            return "shirt_roll";
     }
     return "?";
+}
+
+bool is_rolled(SceneFamily family) {
+    // RolledBoth keeps it: on top both layers run back, so the side of the outer one that the
+    // inner one lies on, taken along its direction of travel, is the same as below.
+    return family == SceneFamily::Rolled || family == SceneFamily::RolledTwice ||
+           family == SceneFamily::ShirtRoll;
 }
 
 Scene make_scene(SceneFamily family, const FamilyParams& params) {
@@ -245,6 +329,15 @@ Scene make_scene(SceneFamily family, const FamilyParams& params) {
             break;
         case SceneFamily::Legs:
             layers = legs(params);
+            break;
+        case SceneFamily::RolledTwice:
+            layers = rolled_twice(params);
+            break;
+        case SceneFamily::RolledBoth:
+            layers = rolled_both(params);
+            break;
+        case SceneFamily::ShirtRoll:
+            layers = shirt_roll(params);
             break;
     }
     for (Layer& layer : layers) {

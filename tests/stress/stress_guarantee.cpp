@@ -1,8 +1,8 @@
 // Randomized stress of strata's guarantee (issue 16): generated scenes of every family
-// (scene_families.h: stack, loops, folded, rolled, jacket, legs; open and closed, one stack,
-// nested and side by side), scales 1e-3..1e3, offsets up to 1e6, x decimators x removal levels,
-// each simplified at 1 and at 2 threads. Every output must pass the exact check (no crossing,
-// no self-crossing, nesting kept, every gap >= (1 - 0.1) x required), and the two thread
+// (scene_families.h: stack, loops, folded, jacket, legs and the rolled ones; open and closed, one
+// stack, nested and side by side), scales 1e-3..1e3, offsets up to 1e6, x decimators x removal
+// levels, each simplified at 1 and at 2 threads. Every output must pass the exact check (no
+// crossing, no self-crossing, nesting kept, every gap >= (1 - 0.1) x required), and the two thread
 // counts must give the same output, point for point.
 //
 //   stress_guarantee [--scenes N] [--seed S] [--points-max P] [--families F,...]
@@ -305,7 +305,7 @@ int main(int argc, char** argv) {
         t.nesting, t.separation_violations, t.min_ratio, t.removed, t.refused, t.untangle_calls,
         t.targets_missed, t.restored_runs, t.restored_vertices, seconds);
     for (const auto& [name, f] : t.per_family)
-        std::printf("  %-7s %5zu scenes %6zu runs %5zu failing\n", name.c_str(), f[0], f[1], f[2]);
+        std::printf("  %-12s %5zu scenes %6zu runs %5zu failing\n", name.c_str(), f[0], f[1], f[2]);
     if (t.errors)
         std::printf("  %zu runs refused with an error (no output; see ERROR lines)\n", t.errors);
     return t.failures == 0 && t.thread_mismatches == 0 && t.scenes > 0 ? 0 : 1;

@@ -100,57 +100,6 @@ Scene wavy_roll(std::size_t points, double gap_in_segments) {
     return Scene({inner, outer});
 }
 
-Scene both_rolled(std::size_t points, double gap_in_segments) {
-    const double s = 10.0 / static_cast<double>(points - 1), g = gap_in_segments * s;
-    auto w = [g](double x) { return 0.3 * g * std::sin(2.0 * x); };
-    Layer inner, outer;
-    inner.name = "inner";
-    outer.name = "outer";
-    inner.thickness = outer.thickness = 0.25 * g;  // required: half a gap, as on the bend
-    auto roll = [&](Layer& layer, double base, double radius) {
-        for (double x = 0.0; x < 9.0; x += s) layer.points.emplace_back(x, base + w(x));
-        const int steps = std::max(4, static_cast<int>(std::ceil(kPi * radius / s)));
-        for (int j = 1; j < steps; ++j) {
-            const double a = -0.5 * kPi + kPi * j / steps;
-            layer.points.emplace_back(9.0 + radius * std::cos(a),
-                                      1.5 * g + radius * std::sin(a) + w(9.0));
-        }
-        for (double x = 9.0; x >= 5.0; x -= s) layer.points.emplace_back(x, 3.0 * g - base + w(x));
-    };
-    roll(inner, 0.0, 1.5 * g);
-    roll(outer, g, 0.5 * g);
-    return Scene({inner, outer});
-}
-
-Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments) {
-    const double s = 2.0 * kPi / static_cast<double>(points);
-    const double g = gap_in_segments * s;
-    auto at = [](double r, double t) { return Vec2(r * std::cos(t), r * std::sin(t)); };
-    Layer body, shirt, jacket;
-    body.name = "body";
-    shirt.name = "shirt";
-    jacket.name = "jacket";
-    body.closed = true;
-    body.thickness = shirt.thickness = jacket.thickness = 0.5 * g;
-    body.outer = std::vector<std::string>{"shirt"};
-    shirt.outer = std::vector<std::string>{"jacket"};
-    jacket.outer = std::vector<std::string>{};
-    for (std::size_t i = 0; i < points; ++i)
-        body.points.push_back(at(1.0, s * static_cast<double>(i)));
-    for (double t = 0.5; t <= 5.0 - 4.0 * g + 1e-12; t += s)
-        jacket.points.push_back(at(1.0 + 2.0 * g, t));
-    for (double t = 0.5; t < 5.0; t += s) shirt.points.push_back(at(1.0 + g, t));
-    const int steps = std::max(4, static_cast<int>(std::ceil(kPi * g / s)));
-    const Vec2 centre = at(1.0 + 2.0 * g, 5.0), radial = at(1.0, 5.0),
-               along = at(1.0, 5.0 + 0.5 * kPi);
-    for (int j = 0; j <= steps; ++j) {  // from radius 1 + g to 1 + 3 g, bulging forward
-        const double a = kPi * j / steps;
-        shirt.points.push_back(centre - g * std::cos(a) * radial + g * std::sin(a) * along);
-    }
-    for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * g, t));
-    return Scene({body, shirt, jacket});
-}
-
 std::filesystem::path test_data(const std::string& name) {
     return std::filesystem::path(STRATA_TEST_DATA_DIR) / name;
 }

@@ -2,6 +2,7 @@
 /// @file Generated scenes with known geometry, for the tests of every module.
 
 #include "strata/geometry/scene.h"
+#include "strata/simplify/scene_families.h"
 
 #include <cstddef>
 #include <filesystem>
@@ -37,18 +38,22 @@ Scene spiral(double turns, std::size_t points);
 /// Thickness half the gap (required separation: half the gap).
 Scene wavy_roll(std::size_t points, double gap_in_segments);
 
-/// Both layers rolled together around a centre at (9, 1.5 gaps): the inner layer (base y = 0)
-/// takes the outside of the bend (radius 1.5 gaps), the outer one (base y = 1 gap) its inside
-/// (radius 0.5 gap); back on top, the inner layer lies over the outer one: the order flips.
-/// Same waves and gap as wavy_roll(); thickness a quarter gap.
-Scene both_rolled(std::size_t points, double gap_in_segments);
+/// make_scene(SceneFamily::RolledBoth) with `points` and `gap_in_segments` (inline: only the
+/// tests that use it link the simplify module).
+inline Scene both_rolled(std::size_t points, double gap_in_segments) {
+    FamilyParams p;
+    p.points = points;
+    p.gap = gap_in_segments;
+    return make_scene(SceneFamily::RolledBoth, p);
+}
 
-/// A shirt rolled over the end of a jacket, both over a closed body: body radius 1 (closed,
-/// `points` vertices, under the shirt), shirt at 1 + gap over angles [0.5, 5], jacket at
-/// 1 + 2 gaps over [0.5, 5 - 4 gaps]; at angle 5 the shirt turns outward around a half circle
-/// of radius 1 gap and comes back at 1 + 3 gaps (over the jacket) to angle 4. Gap =
-/// gap_in_segments x 2 pi / points; thickness half the gap.
-Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments);
+/// make_scene(SceneFamily::ShirtRoll) with `points` and `gap_in_segments`.
+inline Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments) {
+    FamilyParams p;
+    p.points = points;
+    p.gap = gap_in_segments;
+    return make_scene(SceneFamily::ShirtRoll, p);
+}
 
 /// tests/data/<name>
 std::filesystem::path test_data(const std::string& name);

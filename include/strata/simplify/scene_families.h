@@ -14,20 +14,30 @@ namespace strata {
 
 /// The families.
 enum class SceneFamily {
-    Stack,   ///< `layers` open layers offset along the normal of a wavy curve (one stack).
-    Loops,   ///< `layers` concentric wavy closed loops (one stack, each inside the next).
-    Folded,  ///< A stack of `layers` open layers folded twice (an S): its outer layers face
-             ///< each other across the first fold, its inner ones across the second.
-    Rolled,  ///< Two open layers; the inner one comes around the end of the outer one and lies
-             ///< on top of it (the paper's Fig. 7b,c): the global order does not hold there.
-    Jacket,  ///< A closed body loop under an open jacket arc that covers 3/4 of it.
-    Legs,    ///< Two closed leg loops side by side inside a closed skirt loop (`outer` links).
+    Stack,        ///< `layers` open layers offset along the normal of a wavy curve (one stack).
+    Loops,        ///< `layers` concentric wavy closed loops (one stack, each inside the next).
+    Folded,       ///< A stack of `layers` open layers folded twice (an S): its outer layers face
+                  ///< each other across the first fold, its inner ones across the second.
+    Rolled,       ///< Two open layers; the inner one comes around the end of the outer one and lies
+                  ///< on top of it (the paper's Fig. 7b,c): the global order does not hold there.
+    Jacket,       ///< A closed body loop under an open jacket arc that covers 3/4 of it.
+    Legs,         ///< Two closed leg loops side by side inside a closed skirt loop (`outer` links).
+    RolledTwice,  ///< Rolled, then the inner layer's top turned back once more over itself.
+    RolledBoth,   ///< Both layers rolled together: on top the inner one lies over the outer
+                  ///< (both run back there, so the sides along their travel stay as below).
+    ShirtRoll,    ///< A closed body under a shirt rolled over the end of a jacket.
 };
 
 /// All families, in the order above.
 std::vector<SceneFamily> all_scene_families();
-/// "stack", "loops", "folded", "rolled", "jacket", "legs".
+/// "stack", "loops", "folded", "rolled", "jacket", "legs", "rolled_twice", "rolled_both",
+/// "shirt_roll".
 std::string family_name(SceneFamily family);
+/// The family has a part lying on the other side of an open layer than the global order
+/// says (Rolled, RolledTwice, ShirtRoll): its nesting holds against its own sides
+/// (record_input_sides()), not against the global order. Not RolledBoth: rolled together,
+/// each layer's side of the other, taken along its direction of travel, stays the same.
+bool is_rolled(SceneFamily family);
 
 /// Size and spacing of a generated scene.
 struct FamilyParams {
