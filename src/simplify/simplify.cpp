@@ -139,14 +139,18 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     CheckReport check_report = check_scene(out, check_params);
     if (params.untangle && !detail::passes(check_report)) {
         // What the local checks could not see: the input comes back around it.
+        // Kept only when it passes: an input that is itself tangled never does, and then the
+        // simplified result is returned as it is, reported not collision-free.
         detail::Restored restored = detail::restore_near_violations(input, live, out, check_report,
                                                                     check_params, input_sides);
-        out = std::move(restored.scene);
-        report.origins = std::move(restored.origins);
-        check_report = std::move(restored.check);
-        report.restored = restored.restored;
-        report.rolled_vertices =
-            input_sides.renumbered(report.origins).rolled_count(out, outside_signs);
+        if (detail::passes(restored.check)) {
+            out = std::move(restored.scene);
+            report.origins = std::move(restored.origins);
+            check_report = std::move(restored.check);
+            report.restored = restored.restored;
+            report.rolled_vertices =
+                input_sides.renumbered(report.origins).rolled_count(out, outside_signs);
+        }
     }
     report.crossings = check_report.crossing_count;
     report.self_crossings = check_report.total_self_crossings();

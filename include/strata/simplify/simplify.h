@@ -124,7 +124,8 @@ struct SimplifyReport {
     /// where the exact check of the whole result still failed (what the local checks do not
     /// see: a vertex that did not move whose closest point on an open layer moved), the input
     /// came back within a radius of each violation, doubled until the check passed. 0 almost
-    /// always; never when untangle is false (naive decimation keeps its collisions).
+    /// always; 0 when untangle is false (naive decimation keeps its collisions) and when even
+    /// the whole input fails the check (a tangled input: the result is returned as it is).
     std::size_t restored = 0;
     /// Per layer, the input index of every output vertex, in output order (a simplification
     /// keeps vertices and their order; InputSides::renumbered() takes it).

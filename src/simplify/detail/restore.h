@@ -4,7 +4,8 @@
 /// move whose closest point on an open layer moved with that layer), the input comes back
 /// around it: every input vertex within a radius of a violation is put back at its input
 /// position, and the radius doubles until the result is clean. The whole input is the last
-/// step, so a clean input always gives a clean result. Private to src/simplify.
+/// step, so a clean input always gives a clean result (simplify() keeps the result only when
+/// it passes). Private to src/simplify.
 
 #include "simplify/detail/live_polylines.h"
 #include "strata/geometry/checks.h"
