@@ -101,7 +101,12 @@ Run add_untangle_command(CLI::App& app) {
                 params.outside_sides.push_back(outside_side(input, l));
             params.input_sides = &inferred;
         }
+        // Judged as untangle() judges: by the outside sides it untangles toward (the input's
+        // when none are given), not by a fresh vote on the result.
         check_params.outside_sides = params.outside_sides;
+        if (check_params.outside_sides.empty())
+            for (std::size_t l = 0; l < input.size(); ++l)
+                check_params.outside_sides.push_back(outside_side(input, l));
         check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();
