@@ -13,7 +13,8 @@
 // Usage: strata_bench_untangle [--family NAME] [--tangle naive90|naive95|dp]
 //                              [--backend indexed|grid] [--points N] [--timing] [--write DIR]
 //                              [--sides]
-// --write DIR: every case's tangled input (NAME.tangled.json) and result (NAME.json, and
+// --write DIR: every case's generated input (NAME.input.json), tangled input
+// (NAME.tangled.json) and result (NAME.json, and
 // NAME.svg with the tangled input drawn faintly under it), DIR existing.
 // --timing: the two timing cases instead (12 loops x 150 and 6 x 300 stack, naive 90%).
 // --slices DIR (default tests/data/crossing_slices, when run from the repository's root): the
@@ -190,6 +191,7 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
         std::string file = name + "-" + how;
         std::replace(file.begin(), file.end(), ' ', '_');
         const std::string base = write_dir + "/" + file;
+        if (how != "real") write_scene(input, base + ".input.json");
         write_scene(tangled, base + ".tangled.json");
         write_scene(scene, base + ".json");
         SvgWriteParams svg;
