@@ -158,8 +158,7 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
     CheckParams scoring;
     InputSides sides;
     if (keep_sides && how != "real") {
-        for (std::size_t l = 0; l < input.size(); ++l)
-            p.outside_sides.push_back(outside_side(input, l));
+        p.outside_sides = outside_sides(input);
         sides = InputSides::matched(record_input_sides(input), input, tangled);
         p.input_sides = &sides;
         scoring.outside_sides = p.outside_sides;

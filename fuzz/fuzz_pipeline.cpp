@@ -121,12 +121,6 @@ bool clean(const strata::CheckReport& r) {
     return r.is_collision_free() && r.separations_hold();
 }
 
-std::vector<int> sides_of(const strata::Scene& scene) {
-    std::vector<int> sides;
-    for (std::size_t l = 0; l < scene.size(); ++l) sides.push_back(strata::outside_side(scene, l));
-    return sides;
-}
-
 // Valid scenes and parameters that simplify() and untangle() refuse with InvalidInput, an error
 // and not a crash (the CLI prints it and exits 2). Known: the indexed field refuses a layer
 // whose coordinates exceed 1e9 buckets of its segment length, counted from the origin, not
@@ -169,7 +163,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const double tolerance = params.untangling.separation_tolerance;
 
     // An input that crosses is untangled first (the CLI's --input-crossings untangle).
-    const std::vector<int> input_sides = sides_of(scene);
+    const std::vector<int> input_sides = strata::outside_sides(scene);
     if (!strata::check_scene(scene).is_collision_free()) {
         strata::UntangleParams u;
         u.max_passes = static_cast<int>(in.range(1, 8));
@@ -191,7 +185,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
 
     const strata::Scene input = scene;
-    const std::vector<int> sides = sides_of(input);
+    const std::vector<int> sides = strata::outside_sides(input);
     // The input is the reference of the sides of open layers (a rolled part stays rolled).
     const strata::InputSides recorded = strata::record_input_sides(input);
     const bool input_clean = clean(exact_check(input, sides, tolerance, &recorded));

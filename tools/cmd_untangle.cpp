@@ -97,16 +97,13 @@ Run add_untangle_command(CLI::App& app) {
             params.input_sides = &reference->sides;  // untangling keeps the vertex indices
         } else if (opt->infer_sides) {
             inferred = infer_input_sides(input);
-            for (std::size_t l = 0; l < input.size(); ++l)
-                params.outside_sides.push_back(outside_side(input, l));
+            params.outside_sides = outside_sides(input);
             params.input_sides = &inferred;
         }
         // Judged as untangle() judges: by the outside sides it untangles toward (the input's
         // when none are given), not by a fresh vote on the result.
-        check_params.outside_sides = params.outside_sides;
-        if (check_params.outside_sides.empty())
-            for (std::size_t l = 0; l < input.size(); ++l)
-                check_params.outside_sides.push_back(outside_side(input, l));
+        check_params.outside_sides =
+            params.outside_sides.empty() ? outside_sides(input) : params.outside_sides;
         check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();

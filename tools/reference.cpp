@@ -43,10 +43,7 @@ Reference read_reference(const std::string& path, const Scene& scene, double nea
     // ORIG's own sides of its open layers (a rolled part): the scene's vertices take those of
     // the nearest vertex of their layer there.
     const InputSides recorded = record_input_sides(ref.scene);
-    std::vector<int> reference_outside;
-    for (std::size_t l = 0; l < ref.scene.size(); ++l)
-        reference_outside.push_back(outside_side(ref.scene, l, near_distance));
-    ref.rolled = recorded.rolled_count(ref.scene, reference_outside);
+    ref.rolled = recorded.rolled_count(ref.scene, outside_sides(ref.scene, near_distance));
     ref.sides = InputSides::matched(recorded, ref.scene, scene);
     return ref;
 }

@@ -148,9 +148,7 @@ Scene untangle_input(const Scene& start, const Scene& input, const UntangleParam
     Scene again = start;
     const InputSides inferred = infer_input_sides(input);
     UntangleParams v = u;
-    v.outside_sides.clear();
-    for (std::size_t l = 0; l < input.size(); ++l)
-        v.outside_sides.push_back(outside_side(input, l));
+    v.outside_sides = outside_sides(input);
     v.input_sides = &inferred;
     const UntangleReport report = untangle(again, v);
     CheckParams cp;

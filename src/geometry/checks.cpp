@@ -982,6 +982,14 @@ int outside_side(const Scene& scene, std::size_t i) {
     return outside_side(scene, i, 0.0);
 }
 
+std::vector<int> outside_sides(const Scene& scene, double near_distance) {
+    std::vector<int> sides;
+    sides.reserve(scene.size());
+    for (std::size_t l = 0; l < scene.size(); ++l)
+        sides.push_back(outside_side(scene, l, near_distance));
+    return sides;
+}
+
 HausdorffDistance hausdorff(const Layer& a, const Layer& b, double tolerance) {
     if (!std::isfinite(tolerance) || tolerance <= 0.0)
         throw InvalidInput("hausdorff: tolerance must be a finite value > 0 (got " +

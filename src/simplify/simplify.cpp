@@ -109,10 +109,8 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     // The input's sides of the open layers near each vertex: what the local and the final
     // checks keep (a rolled part stays rolled). Outside sides resolved for the untangling, or
     // here when it does not run.
-    std::vector<int> outside_signs = settings.outside_signs;
-    if (outside_signs.empty())
-        for (std::size_t l = 0; l < input.size(); ++l)
-            outside_signs.push_back(outside_side(input, l));
+    const std::vector<int> outside_signs =
+        settings.outside_signs.empty() ? outside_sides(input) : settings.outside_signs;
     // Found when asked for: by the local checks and the untanglings for the vertices they
     // move, by the final check for the vertices kept.
     const InputSides input_sides = record_input_sides(input);

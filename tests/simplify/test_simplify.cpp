@@ -352,8 +352,7 @@ TEST_CASE("crossing real slices untangled then simplified come out clean", "[sim
             INFO(name << " at " << remove);
             CHECK(report.collision_free);
             CheckParams cp;
-            for (std::size_t l = 0; l < scene.size(); ++l)
-                cp.outside_sides.push_back(outside_side(scene, l));
+            cp.outside_sides = outside_sides(scene);
             cp.separation_tolerance = params.untangling.separation_tolerance;
             const InputSides sides = record_input_sides(scene).renumbered(report.origins);
             cp.input_sides = &sides;

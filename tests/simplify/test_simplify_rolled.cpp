@@ -18,12 +18,6 @@ using namespace strata;
 
 namespace {
 
-std::vector<int> outside_sides(const Scene& scene) {
-    std::vector<int> sides;
-    for (std::size_t l = 0; l < scene.size(); ++l) sides.push_back(outside_side(scene, l));
-    return sides;
-}
-
 std::vector<std::vector<std::size_t>> identity(const Scene& scene) {
     std::vector<std::vector<std::size_t>> ids;
     for (const Layer& layer : scene.layers()) {

@@ -25,12 +25,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::vector<int> outside_sides(const Scene& scene) {
-    std::vector<int> sides;
-    for (std::size_t l = 0; l < scene.size(); ++l) sides.push_back(outside_side(scene, l));
-    return sides;
-}
-
 // Where the line p + t d (t >= 0) meets `layer` first, as t; -1 when it does not.
 double ray_hit(const Layer& layer, const Vec2& p, const Vec2& d) {
     double best = -1.0;

@@ -89,12 +89,6 @@ Case random_case(std::mt19937_64& rng, std::size_t index, const Options& opt) {
     return c;
 }
 
-std::vector<int> sides_of(const Scene& scene) {
-    std::vector<int> sides;
-    for (std::size_t l = 0; l < scene.size(); ++l) sides.push_back(outside_side(scene, l));
-    return sides;
-}
-
 // `input_sides`: the sides recorded in the input, renumbered to `scene`'s vertices, or
 // nullptr (the global order).
 CheckReport exact_check(const Scene& scene, const std::vector<int>& sides, double tolerance,
@@ -181,7 +175,7 @@ int main(int argc, char** argv) {
             continue;
         }
         const double tolerance = SimplifyParams{}.untangling.separation_tolerance;
-        const std::vector<int> sides = sides_of(input);
+        const std::vector<int> sides = outside_sides(input);
         const InputSides input_sides = record_input_sides(input);
         const CheckReport in_check = exact_check(input, sides, tolerance, &input_sides);
         if (!(in_check.is_collision_free() && in_check.separations_hold())) {

@@ -45,8 +45,7 @@ detail::SeparationResult finish(Scene& scene, const Scene* sides_from = nullptr)
     detail::RelationSource relations;
     relations.scene = &scene;
     const Scene input = sides_from ? *sides_from : scene;
-    std::vector<int> sides;
-    for (std::size_t i = 0; i < scene.size(); ++i) sides.push_back(outside_side(input, i));
+    const std::vector<int> sides = outside_sides(input);
     detail::SeparationParams params;
     params.outside_signs = &sides;
     return detail::finish_separations(scene, pieces, relations, params);
@@ -156,8 +155,7 @@ TEST_CASE("the finishing stage pulls back an open end that crosses a side-by-sid
     pieces[1].is_free.assign(pieces[1].is_free.size(), 0);  // the upper piece stays
     detail::RelationSource relations;
     relations.scene = &scene;
-    std::vector<int> sides;
-    for (std::size_t i = 0; i < scene.size(); ++i) sides.push_back(outside_side(scene, i));
+    const std::vector<int> sides = outside_sides(scene);
     detail::SeparationParams params;
     params.outside_signs = &sides;
     const detail::SeparationResult r = detail::finish_separations(scene, pieces, relations, params);

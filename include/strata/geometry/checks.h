@@ -153,6 +153,9 @@ int outside_side(const Scene& scene, std::size_t i);
 /// outside_side() with an explicit near distance (scene units, >= 0; 0 = automatic), as
 /// check_scene() uses it.  @throws InvalidInput bad near_distance.
 int outside_side(const Scene& scene, std::size_t i, double near_distance);
+/// outside_side() of every layer of `scene`, in layer order (CheckParams::outside_sides,
+/// UntangleParams::outside_sides).  @throws InvalidInput bad near_distance.
+std::vector<int> outside_sides(const Scene& scene, double near_distance = 0.0);
 
 /// One-sided and symmetric Hausdorff distances between two polylines, scene units.
 struct HausdorffDistance {
