@@ -351,12 +351,9 @@ TEST_CASE("crossing real slices untangled then simplified come out clean", "[sim
             const SimplifyReport report = simplify(out, params);
             INFO(name << " at " << remove);
             CHECK(report.collision_free);
-            CheckParams cp;
-            cp.outside_sides = outside_sides(scene);
-            cp.separation_tolerance = params.untangling.separation_tolerance;
             const InputSides sides = record_input_sides(scene).renumbered(report.origins);
-            cp.input_sides = &sides;
-            const CheckReport check = check_scene(out, cp);
+            const CheckReport check = test::check_with_sides(
+                out, outside_sides(scene), params.untangling.separation_tolerance, &sides);
             CHECK(check.is_collision_free());
             CHECK(check.separations_hold());
             if (report.restored > 0) ++restored_slices;

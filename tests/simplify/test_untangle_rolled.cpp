@@ -9,6 +9,7 @@
 #include "strata/simplify/simplify.h"
 #include "strata/untangle/untangle.h"
 #include "support/fixtures.h"
+#include "support/require.h"
 
 #include <catch2/catch.hpp>
 
@@ -165,15 +166,8 @@ TEST_CASE("untangle keeps a roll with the original's sides (naive decimation at 
                 CHECK(report.rolled_kept == report.rolled_vertices);
 
                 // Checked again here against the original's sides.
-                CheckParams cp;
-                cp.outside_sides = outside;
-                cp.separation_tolerance = params.separation_tolerance;
-                cp.input_sides = &sides;
-                const CheckReport check = check_scene(out, cp);
-                CHECK(check.crossing_count == 0);
-                CHECK(check.total_self_crossings() == 0);
-                CHECK(check.nesting_violation_count == 0);
-                CHECK(check.min_separation_ratio >= 0.9);
+                test::require_sides_kept(
+                    test::check_with_sides(out, outside, params.separation_tolerance, &sides), 0.9);
                 // The roll is kept: what lay on top of the other layer still does.
                 const auto [judged, on_top] = still_on_top(c, tangled, out);
                 CHECK(judged > 0);
@@ -191,7 +185,8 @@ TEST_CASE("untangle keeps a roll with the original's sides (naive decimation at 
                 Scene global = tangled;
                 const UntangleReport g = untangle(global);
                 CHECK(g.rolled_vertices == 0);
-                const CheckReport gc = check_scene(global, cp);
+                const CheckReport gc =
+                    test::check_with_sides(global, outside, params.separation_tolerance, &sides);
                 const auto [judged_global, on_top_global] = still_on_top(c, tangled, global);
                 const bool rolled = g.collision_free && gc.nesting_violation_count == 0 &&
                                     on_top_global == judged_global &&
@@ -299,15 +294,8 @@ TEST_CASE("untangle with sides inferred per region keeps a roll (no original at 
                     ++cut;
                     continue;
                 }
-                CheckParams cp;
-                cp.outside_sides = std::vector<int>(outside);
-                cp.separation_tolerance = params.separation_tolerance;
-                cp.input_sides = &sides;
-                const CheckReport check = check_scene(out, cp);
-                CHECK(check.crossing_count == 0);
-                CHECK(check.total_self_crossings() == 0);
-                CHECK(check.nesting_violation_count == 0);
-                CHECK(check.min_separation_ratio >= 0.9);
+                test::require_sides_kept(
+                    test::check_with_sides(out, outside, params.separation_tolerance, &sides), 0.9);
                 const auto [judged, on_top] = still_on_top(c, tangled, out);
                 CHECK(judged > 0);
                 CHECK(on_top == judged);

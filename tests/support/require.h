@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <vector>
+
 namespace strata::test {
 
 /// Exact equality of two scenes: names, flags, parameters, nesting and bit-exact points; with
@@ -42,6 +44,28 @@ inline void require_collision_free(const Scene& scene, double tol) {
     CHECK(check.total_self_crossings() == 0);
     CHECK(check.nesting_violation_count == 0);
     CHECK(check.separation_violation_count == 0);
+}
+
+/// check_scene() of `scene` as simplify() and untangle() judge their results: the open layers'
+/// outside sides `outside` (outside_sides() of the scene it comes from), the sides `sides`
+/// recorded there and carried onto `scene`'s vertices (nullptr: the global order), the
+/// separation tolerance `tol`.
+inline CheckReport check_with_sides(const Scene& scene, const std::vector<int>& outside, double tol,
+                                    const InputSides* sides) {
+    CheckParams params;
+    params.outside_sides = outside;
+    params.separation_tolerance = tol;
+    params.input_sides = sides;
+    return check_scene(scene, params);
+}
+
+/// `check` finds no crossing, self-crossing or nesting violation, and every gap is at least
+/// `min_ratio` x required.
+inline void require_sides_kept(const CheckReport& check, double min_ratio) {
+    CHECK(check.crossing_count == 0);
+    CHECK(check.total_self_crossings() == 0);
+    CHECK(check.nesting_violation_count == 0);
+    CHECK(check.min_separation_ratio >= min_ratio);
 }
 
 }  // namespace strata::test
