@@ -9,9 +9,10 @@ namespace strata::detail {
 
 namespace {
 
-// Where `check` (on `out`, with separation tolerance `tolerance`) finds something wrong.
-std::vector<Vec2> violation_points(const Scene& out, const CheckReport& check, double tolerance) {
-    std::vector<Vec2> points;
+// Adds to `points` where `check` (on `out`, with separation tolerance `tolerance`) finds
+// something wrong, and sorts them by x (within() looks them up so).
+void add_violation_points(const Scene& out, const CheckReport& check, double tolerance,
+                          std::vector<Vec2>& points) {
     for (const Crossing& c : check.crossings) points.push_back(c.point);
     for (const Crossing& c : check.self_crossings) points.push_back(c.point);
     for (const NestingViolation& v : check.nesting_violations)
@@ -26,7 +27,6 @@ std::vector<Vec2> violation_points(const Scene& out, const CheckReport& check, d
         }
     std::sort(points.begin(), points.end(),
               [](const Vec2& a, const Vec2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    return points;
 }
 
 // Some point of `sorted` (by x) within r of p.
@@ -46,7 +46,8 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
     Restored result;
     const Vec2 size = input.bounds().size();
     const double diagonal = std::hypot(size.x, size.y);
-    std::vector<Vec2> points = violation_points(out, check, params.separation_tolerance);
+    std::vector<Vec2> points;
+    add_violation_points(out, check, params.separation_tolerance, points);
     // From an eighth of the check's near distance, doubling; past the diagonal every vertex
     // is back (the input).
     double radius = automatic_near_distance(input) / 8.0;
@@ -80,12 +81,7 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
         result.scene = std::move(scene);
         if (passes(result.check) || whole) return result;
         // What is still wrong joins the places to restore around.
-        for (const Vec2& p :
-             violation_points(result.scene, result.check, params.separation_tolerance))
-            points.push_back(p);
-        std::sort(points.begin(), points.end(), [](const Vec2& a, const Vec2& b) {
-            return a.x < b.x || (a.x == b.x && a.y < b.y);
-        });
+        add_violation_points(result.scene, result.check, params.separation_tolerance, points);
     }
 }
 
