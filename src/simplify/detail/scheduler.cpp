@@ -64,8 +64,13 @@ SimplifyReport Scheduler::run(const ProgressFn& progress) {
             queue_.pop();
             const std::size_t l = c.layer, v = c.vertex;
             const WorkLayer& w = live_.layer(l);
-            if (c.version != version_[l][v] || !removable(l, v) || w.alive_count <= w.target)
+            if (c.version != version_[l][v]) continue;
+            if (!removable(l, v) || w.alive_count <= w.target) {
+                // A waiting job's removal on this layer may yet be refused and give its vertex
+                // back: keep the candidate until the batch has run.
+                if (w.alive[v] && !w.locked[v] && waits_on(l)) held_.push_back(c);
                 continue;
+            }
             const std::size_t a = w.prev[v], b = w.next[v];
             if (params_.max_error > 0.0 && span_error(view(l), a, b) > params_.max_error) {
                 live_.lock(l, v);
@@ -258,6 +263,13 @@ void Scheduler::remove_batched(const Candidate& c) {
     if (pending_.size() >= params_.batch || (w.closed && w.alive_count <= 3)) flush();
 }
 
+// A job of the batch removes a vertex of layer l.
+bool Scheduler::waits_on(std::size_t l) const {
+    for (const Job& job : pending_)
+        if (job.l == l) return true;
+    return false;
+}
+
 // Sets candidate c aside until the batch has run; runs it when too many wait.
 void Scheduler::postpone(const Candidate& c) {
     postponed_.push_back(c);
@@ -271,6 +283,8 @@ void Scheduler::flush() {
     if (pending_.empty()) {
         for (const Candidate& c : postponed_) queue_.push(c);
         postponed_.clear();
+        for (const Candidate& c : held_) queue_.push(c);
+        held_.clear();
         return;
     }
     ++report_.batches;
@@ -301,6 +315,8 @@ void Scheduler::flush() {
     touched_.clear();
     for (const Candidate& c : postponed_) queue_.push(c);
     postponed_.clear();
+    for (const Candidate& c : held_) queue_.push(c);
+    held_.clear();
     for (std::size_t i : again) {
         const Job& job = jobs[i];
         report_.seconds_fields += job.result.seconds_fields;  // the first run's time

@@ -60,6 +60,7 @@ class Scheduler {
     bool untangle_now(std::size_t l, std::size_t v);
     bool commit(const Job& job);
     void remove_batched(const Candidate& c);
+    bool waits_on(std::size_t l) const;
     void postpone(const Candidate& c);
     void flush();
     bool batching() const { return params_.untangle && !defer_ && !params_.global; }
@@ -80,6 +81,9 @@ class Scheduler {
     };
     std::vector<Touched> touched_;
     std::vector<Candidate> postponed_;  // set aside until the batch has run
+    // Candidates of layers that looked done while a removal on them waited in the batch (it
+    // may be refused): queued again after the batch, without counting towards its size.
+    std::vector<Candidate> held_;
     std::size_t done_ = 0;              // removals kept
     SimplifyReport report_;
 };
