@@ -4,10 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 
 namespace strata::detail {
 
 namespace {
+
+// Vertices the checks of thin() may read in all (about 2 us each: a few seconds).
+constexpr std::size_t kThinningBudget = 2'000'000;
 
 // Adds to `points` where `check` (on `out`, with separation tolerance `tolerance`) finds
 // something wrong, and sorts them by x (within() looks them up so).
@@ -38,6 +43,96 @@ bool within(const std::vector<Vec2>& sorted, const Vec2& p, double r) {
     return false;
 }
 
+// A vertex put back that thin() may take out again.
+struct Restorable {
+    double cost;               // twice the area of its triangle (Visvalingam)
+    std::size_t layer, index;  // index: in the restored scene's layer
+};
+
+// Takes out again the vertices of `result` that came back from removal (`came_back`, per layer
+// and vertex of result.scene), cheapest first, as long as their layer is above its target
+// (`targets`) and the exact check still passes: a group at once, halved where it fails (few
+// checks when most may go). At most `max_checks` checks.
+void thin(const Scene& input, Restored& result, const std::vector<std::vector<char>>& came_back,
+          const std::vector<std::size_t>& targets, CheckParams params, const InputSides& sides,
+          std::size_t max_checks) {
+    const Scene base = result.scene;
+    const std::vector<std::vector<std::size_t>> base_origins = result.origins;
+    const std::size_t layers = base.size();
+    std::vector<Restorable> candidates;
+    std::vector<std::size_t> spare(layers, 0);  // removals each layer can still take
+    for (std::size_t l = 0; l < layers; ++l) {
+        const Layer& layer = base.layer(l);
+        const std::size_t n = layer.points.size();
+        const std::size_t floor = std::max(targets[l], layer.closed ? std::size_t{3} : 2);
+        spare[l] = n > floor ? n - floor : 0;
+        for (std::size_t k = 0; k < n && spare[l] > 0; ++k) {
+            if (!came_back[l][k] || (!layer.closed && (k == 0 || k + 1 == n))) continue;
+            const Vec2& a = layer.points[k == 0 ? n - 1 : k - 1];
+            const Vec2& b = layer.points[k];
+            const Vec2& c = layer.points[k + 1 == n ? 0 : k + 1];
+            const double area2 = std::abs((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
+            candidates.push_back({area2, l, k});
+        }
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const Restorable& a, const Restorable& b) {
+        return std::tie(a.cost, a.layer, a.index) < std::tie(b.cost, b.layer, b.index);
+    });
+    std::vector<std::vector<char>> kept(layers);  // per vertex of `base`: still there
+    for (std::size_t l = 0; l < layers; ++l) kept[l].assign(base.layer(l).points.size(), 1);
+    std::size_t checks = 0;
+    // Takes out the candidates [begin, end) their layers can spare; true if that passes.
+    auto attempt = [&](std::size_t begin, std::size_t end) {
+        std::vector<std::size_t> taken;
+        std::vector<std::size_t> spent(layers, 0);
+        for (std::size_t i = begin; i < end; ++i) {
+            const Restorable& c = candidates[i];
+            if (spent[c.layer] == spare[c.layer]) continue;
+            ++spent[c.layer];
+            kept[c.layer][c.index] = 0;
+            taken.push_back(i);
+        }
+        if (taken.empty()) return true;
+        std::vector<Layer> thinned = base.layers();
+        std::vector<std::vector<std::size_t>> origins(layers);
+        for (std::size_t l = 0; l < layers; ++l) {
+            thinned[l].points.clear();
+            for (std::size_t k = 0; k < kept[l].size(); ++k)
+                if (kept[l][k]) {
+                    thinned[l].points.push_back(base.layer(l).points[k]);
+                    origins[l].push_back(base_origins[l][k]);
+                }
+        }
+        Scene scene(std::move(thinned), input.units());
+        scene.metadata = input.metadata;
+        for (const Scene::RaisedSeparation& r : input.raised_separations())
+            scene.raise_required_separation(r.a, r.b, r.value);
+        const InputSides renumbered = sides.renumbered(origins);
+        params.input_sides = &renumbered;
+        ++checks;
+        CheckReport check = check_scene(scene, params);
+        if (!passes(check)) {
+            for (std::size_t i : taken) kept[candidates[i].layer][candidates[i].index] = 1;
+            return false;
+        }
+        for (std::size_t i : taken) --spare[candidates[i].layer];
+        result.restored -= taken.size();
+        result.scene = std::move(scene);
+        result.origins = std::move(origins);
+        result.check = std::move(check);
+        return true;
+    };
+    std::vector<std::pair<std::size_t, std::size_t>> groups{{0, candidates.size()}};
+    while (!groups.empty() && checks < max_checks) {
+        const auto [begin, end] = groups.back();
+        groups.pop_back();
+        if (begin >= end || attempt(begin, end) || end - begin == 1) continue;
+        const std::size_t middle = begin + (end - begin) / 2;
+        groups.push_back({middle, end});  // after the first half
+        groups.push_back({begin, middle});
+    }
+}
+
 }  // namespace
 
 Restored restore_near_violations(const Scene& input, const LivePolylines& live, const Scene& out,
@@ -48,6 +143,7 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
     const double diagonal = std::hypot(size.x, size.y);
     std::vector<Vec2> points;
     add_violation_points(out, check, params.separation_tolerance, points);
+    std::vector<std::vector<char>> came_back;  // per layer and vertex of the candidate
     // From an eighth of the check's near distance, doubling; past the diagonal every vertex
     // is back (the input).
     double radius = automatic_near_distance(input) / 8.0;
@@ -58,6 +154,7 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
         std::vector<Layer> layers = input.layers();
         result.origins.assign(input.size(), {});
         result.restored = 0;
+        came_back.assign(input.size(), {});
         for (std::size_t l = 0; l < input.size(); ++l) {
             const WorkLayer& w = live.layer(l);
             std::vector<Vec2> kept;
@@ -67,6 +164,7 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
                 if (!back && !w.alive[i]) continue;
                 if (back && (!w.alive[i] || w.pos[i] != w.original[i])) ++result.restored;
                 kept.push_back(back ? w.original[i] : w.pos[i]);
+                came_back[l].push_back(!w.alive[i]);
                 result.origins[l].push_back(i);
             }
             layers[l].points = std::move(kept);
@@ -79,7 +177,17 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
         params.input_sides = &renumbered;
         result.check = check_scene(scene, params);
         result.scene = std::move(scene);
-        if (passes(result.check) || whole) return result;
+        if (passes(result.check)) {
+            // Then what the radius put back needlessly goes again, within a budget of
+            // checks (each reads the whole scene).
+            std::vector<std::size_t> targets(input.size());
+            for (std::size_t l = 0; l < input.size(); ++l) targets[l] = live.layer(l).target;
+            const std::size_t checks = std::max<std::size_t>(
+                1, kThinningBudget / std::max<std::size_t>(1, input.vertex_count()));
+            thin(input, result, came_back, targets, params, sides, checks);
+            return result;
+        }
+        if (whole) return result;
         // What is still wrong joins the places to restore around.
         add_violation_points(result.scene, result.check, params.separation_tolerance, points);
     }

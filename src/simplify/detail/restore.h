@@ -5,7 +5,9 @@
 /// around it: every input vertex within a radius of a violation is put back at its input
 /// position, and the radius doubles until the result is clean. The whole input is the last
 /// step, so a clean input always gives a clean result (simplify() keeps the result only when
-/// it passes). Private to src/simplify.
+/// it passes). Then the vertices the radius brought back needlessly go again: those of layers
+/// above their target, cheapest first (Visvalingam), a group at a time, kept out when the
+/// exact check still passes, the group halved where it does not. Private to src/simplify.
 
 #include "simplify/detail/live_polylines.h"
 #include "strata/geometry/checks.h"
@@ -22,7 +24,8 @@ struct Restored {
     Scene scene;                                    ///< The result, vertices in input order.
     std::vector<std::vector<std::size_t>> origins;  ///< Per layer, the input id of each vertex.
     CheckReport check;                              ///< check_scene() of `scene`.
-    std::size_t restored = 0;  ///< Input vertices put back, or moved back to their input place.
+    /// Input vertices put back (and not taken out again), or moved back to their input place.
+    std::size_t restored = 0;
     int steps = 0;             ///< Radii tried.
 };
 
