@@ -105,7 +105,7 @@ echo "untangled: inputs that crossed, untangled before simplifying; failed: not 
 echo "reason is in the .simplify.json: e.g. a layer that crosses itself cannot be untangled);"
 echo "naive-x / strata-x: crossings after naive decimation / after strata; tangled: outputs not collision-free;"
 echo "over-5%: layers (of more than 3 vertices) kept more than 5% above their target;"
-echo "gap-ratio: smallest gap after / gap before over the near pairs (bench/gap_ratios.py); <0.9: pairs below 0.9;"
+echo "gap-ratio: smallest gap after / gap before over the near pairs that do not cross in the input (bench/gap_ratios.py); <0.9: pairs below 0.9;"
 echo "bad: of those, outputs of inputs that were collision-free as read (the guarantee)"
 echo "galleries: $out/<outfit>.html"
 # Fail when an output has crossings, or when an output of a collision-free input is not
