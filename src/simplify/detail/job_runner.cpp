@@ -215,15 +215,21 @@ void JobRunner::execute(Job& job) const {
             moving.insert(seg, box);
         }
         if (!check_.removal_clear(job.l, job.a, job.removed, job.b, ov)) return false;
+        // The segments with a moved end: two segments that both stay where they are live were
+        // clear there (the chord (a, b) aside, which removal_clear() reads).
         for (std::size_t r = 0; r < job.runs.size(); ++r) {
             const Run& run = job.runs[r];
             const WorkLayer& o = live_.layer(run.layer);
+            auto moved = [&](std::size_t id) { return ov.pos(run.layer, id) != o.pos[id]; };
             for (std::size_t k = 0; k < run.ids.size(); ++k) {
                 if (!job.pieces[r].is_free[k]) continue;
                 const std::size_t id = run.ids[k];
-                if (o.prev[id] != kNone && !check_.segment_clear(run.layer, o.prev[id], id, ov))
+                const bool here = moved(id);
+                if (o.prev[id] != kNone && (here || moved(o.prev[id])) &&
+                    !check_.segment_clear(run.layer, o.prev[id], id, ov))
                     return false;
-                if (o.next[id] != kNone && !check_.segment_clear(run.layer, id, o.next[id], ov))
+                if (o.next[id] != kNone && (here || moved(o.next[id])) &&
+                    !check_.segment_clear(run.layer, id, o.next[id], ov))
                     return false;
             }
             if (!check_.closed_valid(run.layer, ov)) return false;
