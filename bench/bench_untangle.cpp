@@ -5,14 +5,20 @@
 // with untangle = false) and per-layer Douglas-Peucker (Boost.Geometry's simplify, what
 // shapely or GEOS give when each layer is simplified alone, with the tolerance bisected per
 // layer to remove about 90% of its vertices). Each case is untangled with the default
-// UntangleParams (the backend from --backend) and scored by the exact check:
+// UntangleParams (the backend from --backend) as `strata untangle` does without an original
+// (untangle_inferring_sides(): the sides inferred per region where the input has rolled
+// regions and that comes out clean, else the global order) and scored by the exact check:
 //   clean = no crossing or self-crossing, nesting kept, and the worst gap / required ratio
 //           >= 0.9 x min(1, the untangled input's ratio).
+// Nesting is judged against the sides of the un-decimated input (record_input_sides(),
+// matched onto the tangled scene): a rolled part must stay rolled; elsewhere those are the
+// global order's. A real slice has no such input: the global order judges it, or the sides
+// inferred per region of it when the untangling kept those.
 // Columns: crossings and nesting violations before/after, the ratio after and its bar, time,
 // moved vertices, the largest Hausdorff distance of a layer to its un-decimated input.
 // Usage: strata_bench_untangle [--family NAME] [--tangle naive90|naive95|dp]
 //                              [--backend indexed|grid] [--points N] [--timing] [--write DIR]
-//                              [--sides]
+//                              [--sides | --global-order]
 // --write DIR: every case's generated input (NAME.input.json), tangled input
 // (NAME.tangled.json) and result (NAME.json, and
 // NAME.svg with the tangled input drawn faintly under it), DIR existing.
@@ -22,11 +28,12 @@
 // "real"): slices of real garments (../shared/data/garments, bench/garments.sh) where the
 // meshes interpenetrate. "--slices none" leaves them out.
 // --sides: the un-decimated input is the reference, as `strata untangle --reference` has it:
-// its sides of the open layers (record_input_sides(), matched onto the tangled scene) are kept
-// (UntangleParams::input_sides, outside_sides), and nesting is scored against them (a rolled
-// part must stay rolled). Real slices are untangled as they are (their input is the tangle).
+// its sides of the open layers are given to untangle() (UntangleParams::input_sides,
+// outside_sides). Real slices are untangled as without it (their input is the tangle).
+// --global-order: untangle() by the global order alone (`strata untangle --global-order`).
 
 #include "strata/core/error.h"
+#include "strata/core/progress.h"
 #include "strata/geometry/checks.h"
 #include "strata/geometry/input_sides.h"
 #include "strata/io/scene_io.h"
@@ -146,23 +153,26 @@ struct Row {
     bool capped = false;
 };
 
-std::string write_dir;    // --write
-bool keep_sides = false;  // --sides
+std::string write_dir;      // --write
+bool keep_sides = false;    // --sides
+bool global_order = false;  // --global-order
 
 Row run(const std::string& name, const std::string& how, const Scene& input,
         const UntangleParams& params, double cap_seconds) {
     const CheckReport original = check_scene(input);
     const Scene tangled = how == "real" ? input : tangle(input, how);
-    // --sides: the input's sides carried onto the tangled scene, kept and scored.
+    // The input's sides carried onto the tangled scene: scored, and with --sides kept.
     UntangleParams p = params;
     CheckParams scoring;
     InputSides sides;
-    if (keep_sides && how != "real") {
-        p.outside_sides = outside_sides(input);
+    if (how != "real") {
+        scoring.outside_sides = outside_sides(input);
         sides = InputSides::matched(record_input_sides(input), input, tangled);
-        p.input_sides = &sides;
-        scoring.outside_sides = p.outside_sides;
         scoring.input_sides = &sides;
+        if (keep_sides) {
+            p.outside_sides = scoring.outside_sides;
+            p.input_sides = &sides;
+        }
     }
     const CheckReport before = check_scene(tangled, scoring);
     Scene scene = tangled;
@@ -170,13 +180,22 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
     Row row;
     UntangleReport report;
     try {
-        report = untangle(scene, p,
-                          [&](std::string_view, double) { return now() - start < cap_seconds; });
+        const ProgressFn capped = [&](std::string_view, double) {
+            return now() - start < cap_seconds;
+        };
+        report = keep_sides || global_order ? untangle(scene, p, capped)
+                                            : untangle_inferring_sides(scene, p, capped);
     } catch (const Cancelled&) {
         row.capped = true;
         scene = tangled;
     }
     const double seconds = now() - start;
+    InputSides inferred;
+    if (how == "real" && report.inferred_sides) {  // judged as untangle judged it
+        inferred = infer_input_sides(tangled);
+        scoring.outside_sides = outside_sides(tangled);
+        scoring.input_sides = &inferred;
+    }
     const CheckReport after = check_scene(scene, scoring);
     const double bar = 0.9 * std::min(1.0, original.min_separation_ratio);
     row.clean = !row.capped && after.is_collision_free() && after.min_separation_ratio >= bar;
@@ -197,12 +216,13 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
         svg.underlay = &tangled;
         write_scene_svg(scene, base + ".svg", svg);
     }
-    std::printf("%-22s %-8s %5zux%-5zu %5zu/%-5zu %5zu/%-5zu %7.3f %6.3f %8.3f %8zu %10.3g %5s%s\n",
-                name.c_str(), how.c_str(), tangled.size(), tangled.vertex_count() / tangled.size(),
-                before.crossing_count, after.crossing_count, before.nesting_violation_count,
-                after.nesting_violation_count, after.min_separation_ratio, bar, seconds,
-                report.moved_vertices, hausdorff, row.clean ? "yes" : "NO",
-                row.capped ? " (time cap)" : "");
+    std::printf(
+        "%-22s %-8s %5zux%-5zu %5zu/%-5zu %5zu/%-5zu %7.3f %6.3f %8.3f %8zu %10.3g %5s%s%s\n",
+        name.c_str(), how.c_str(), tangled.size(), tangled.vertex_count() / tangled.size(),
+        before.crossing_count, after.crossing_count, before.nesting_violation_count,
+        after.nesting_violation_count, after.min_separation_ratio, bar, seconds,
+        report.moved_vertices, hausdorff, row.clean ? "yes" : "NO", row.capped ? " (time cap)" : "",
+        report.inferred_sides ? " (inferred sides)" : "");
     std::fflush(stdout);
     return row;
 }
@@ -252,17 +272,25 @@ int main(int argc, char** argv) {
             slices = value();
         else if (key == "--sides")
             keep_sides = true;
+        else if (key == "--global-order")
+            global_order = true;
         else {
-            std::fprintf(stderr,
-                         "usage: strata_bench_untangle [--family NAME] [--tangle "
-                         "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
-                         "[--timing] [--write DIR] [--slices DIR|none] [--sides]\n");
+            std::fprintf(
+                stderr,
+                "usage: strata_bench_untangle [--family NAME] [--tangle "
+                "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
+                "[--timing] [--write DIR] [--slices DIR|none] [--sides | --global-order]\n");
             return 2;
         }
     }
     if (backend != "indexed" && backend != "grid") {
         std::fprintf(stderr, "strata_bench_untangle: --backend must be indexed or grid (got %s)\n",
                      backend.c_str());
+        return 2;
+    }
+    if (keep_sides && global_order) {
+        std::fprintf(stderr,
+                     "strata_bench_untangle: --sides and --global-order exclude each other\n");
         return 2;
     }
     if (!write_dir.empty()) std::filesystem::create_directories(write_dir);

@@ -248,9 +248,9 @@ Run add_simplify_command(CLI::App& app) {
                 name.c_str(), untangled->crossings, untangled->nesting_violations,
                 untangled->report.moved_vertices, untangled->report.max_displacement,
                 untangled->report.min_separation_ratio_after, untangled->report.passes,
-                untangled->inferred_sides
-                    ? "; the sides of open layers inferred per region of the input, as "
-                      "'strata untangle --infer-sides'"
+                untangled->report.inferred_sides
+                    ? "; it has rolled regions: the sides of open layers inferred per region "
+                      "of the input, as 'strata untangle' does"
                     : "");
         Scene result, naive;
         const Outcome out = run_one(*prepared, o, terminal_progress(), result, &naive);

@@ -30,6 +30,7 @@ struct UntangleOptions {
     bool no_shape_matching = false;
     bool no_finish = false;
     bool infer_sides = false;
+    bool global_order = false;
     UntangleParams params;
 };
 
@@ -48,12 +49,18 @@ Run add_untangle_command(CLI::App& app) {
     cmd->add_option("--reference", opt->reference,
                     "Original scene (before decimation), layers matched by name: every vertex "
                     "keeps the side of the open layers it has there (a rolled or folded-over "
-                    "part stays so); without it, the global order everywhere");
+                    "part stays so); without it, the sides inferred per region (as --infer-sides) "
+                    "where the input has rolled regions and that comes out clean, else the global "
+                    "order");
     cmd->add_flag("--infer-sides", opt->infer_sides,
                   "Without the original: take the sides of the open layers from the input "
                   "itself, each region of a layer on the side most of its vertices are (a "
                   "rolled part stays so, a vertex a tangle put across takes its region's)")
         ->excludes("--reference");
+    cmd->add_flag("--global-order", opt->global_order,
+                  "The global order everywhere, also over a rolled part (which it pushes back)")
+        ->excludes("--reference")
+        ->excludes("--infer-sides");
     cmd->add_option("--thickness", opt->thickness,
                     "Thickness for layers whose thickness is 0 (scene units)")
         ->capture_default_str();
@@ -107,9 +114,17 @@ Run add_untangle_command(CLI::App& app) {
         check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();
-        const UntangleReport r = untangle(scene, params, terminal_progress());
+        const bool fallback = !params.input_sides && !opt->global_order;
+        const UntangleReport r = fallback
+                                     ? untangle_inferring_sides(scene, params, terminal_progress())
+                                     : untangle(scene, params, terminal_progress());
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (r.inferred_sides) {  // the input's rolled regions were kept
+            inferred = infer_input_sides(input);
+            params.input_sides = &inferred;
+            check_params.input_sides = &inferred;
+        }
         const CheckReport after = check_scene(scene, check_params);
 
         write_scene(scene, opt->output);
@@ -158,10 +173,10 @@ Run add_untangle_command(CLI::App& app) {
         if (params.input_sides)
             std::printf(
                 "sides %s %s: %zu vertices on a rolled side (the other side of an open layer "
-                "than the global order), %zu kept it\n",
+                "than the global order), %zu kept it%s\n",
                 reference ? "from" : "inferred from",
                 reference ? opt->reference.c_str() : opt->input.c_str(), r.rolled_vertices,
-                r.rolled_kept);
+                r.rolled_kept, r.inferred_sides ? " (the input has rolled regions)" : "");
         std::printf(
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
             "%.4g\n",

@@ -133,33 +133,23 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
 }
 
 // The untangling of a crossing input, from `start` (the input, perhaps with raised
-// separations): the global order, and where that leaves only sides (a part folded or rolled
-// over an open layer, which the global order pushes back) again with the sides inferred per
-// region of the input (`strata untangle --infer-sides`), so that a rolled part stays rolled.
-// `after`: the check of the result (against the inferred sides when they were taken).
-Scene untangle_input(const Scene& start, const Scene& input, const UntangleParams& u,
-                     InputUntangling& info, CheckReport& after) {
+// separations), as `strata untangle` does it without an original: by the sides inferred per
+// region where the input has rolled regions, else by the global order
+// (untangle_inferring_sides()). `after`:
+// the check of the result (against the inferred sides when they were taken).
+Scene untangle_input(const Scene& start, const UntangleParams& u, InputUntangling& info,
+                     CheckReport& after) {
     Scene scene = start;
-    info.report = untangle(scene, u);
-    info.inferred_sides = false;
-    after = check_scene(scene);
-    if (after.is_collision_free() || after.crossing_count > 0 || after.total_self_crossings() > 0)
-        return scene;
-    Scene again = start;
-    const InputSides inferred = infer_input_sides(input);
-    UntangleParams v = u;
-    v.outside_sides = outside_sides(input);
-    v.input_sides = &inferred;
-    const UntangleReport report = untangle(again, v);
-    CheckParams cp;
-    cp.outside_sides = v.outside_sides;
-    cp.input_sides = &inferred;  // untangling keeps the vertex indices
-    const CheckReport checked = check_scene(again, cp);
-    if (!report.collision_free || !checked.is_collision_free()) return scene;
-    info.report = report;
-    info.inferred_sides = true;
-    after = checked;
-    return again;
+    info.report = untangle_inferring_sides(scene, u);
+    CheckParams check_params;
+    InputSides inferred;
+    if (info.report.inferred_sides) {
+        inferred = infer_input_sides(start);
+        check_params.outside_sides = outside_sides(start);
+        check_params.input_sides = &inferred;  // untangling keeps the vertex indices
+    }
+    after = check_scene(scene, check_params);
+    return scene;
 }
 
 std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
@@ -213,7 +203,7 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
     Scene scene;
     CheckReport after;
     for (const Scene& start : starts) {
-        scene = untangle_input(start, input, u, info, after);
+        scene = untangle_input(start, u, info, after);
         if (after.is_collision_free()) break;
     }
     if (!after.is_collision_free())
@@ -231,7 +221,7 @@ nlohmann::json untangling_json(const InputUntangling& u) {
             {"max_displacement", u.report.max_displacement},
             {"min_separation_ratio_after", finite_or_null(u.report.min_separation_ratio_after)},
             {"passes", u.report.passes},
-            {"sides", u.inferred_sides ? "inferred" : "global"},
+            {"sides", u.report.inferred_sides ? "inferred" : "global"},
             {"seconds", u.report.seconds_fields + u.report.seconds_untangle +
                             u.report.seconds_finish + u.report.seconds_check}};
 }

@@ -38,10 +38,8 @@ struct SimplifyOptions {
 /// What was done to an input that already crossed before it was simplified.
 struct InputUntangling {
     std::size_t crossings = 0, nesting_violations = 0;  ///< Of the input.
+    /// untangle_inferring_sides()'s (report.inferred_sides: the input's rolled regions kept).
     UntangleReport report;
-    /// The global order left only sides: the untangling that passed kept the sides inferred
-    /// per region of the input (infer_input_sides()).
-    bool inferred_sides = false;
 };
 
 /// The outcome of one scene (one slice of a batch).

@@ -434,6 +434,7 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("crossings_before", &UntangleReport::crossings_before)
         .def_readonly("crossings_after", &UntangleReport::crossings_after)
         .def_readonly("min_separation_ratio_after", &UntangleReport::min_separation_ratio_after)
+        .def_readonly("inferred_sides", &UntangleReport::inferred_sides)
         .def_property_readonly("seconds", [](const UntangleReport& r) {
             return r.seconds_fields + r.seconds_untangle + r.seconds_finish + r.seconds_check;
         });
@@ -462,7 +463,7 @@ PYBIND11_MODULE(_strata, m) {
         {
             py::gil_scoped_release release;
             try {
-                r = untangle(out, u, python_progress.callback());
+                r = untangle_inferring_sides(out, u, python_progress.callback());
             } catch (const Cancelled&) {
                 py::gil_scoped_acquire acquire;
                 python_progress.rethrow_if_any();

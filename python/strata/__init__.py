@@ -241,9 +241,12 @@ def untangle(
     finish: bool = True,
     progress: Optional[Callable[[str, float], bool]] = None,
 ) -> Tuple[Scene, UntangleReport]:
-    """Untangles a scene that already crosses (the global mode of ``strata untangle``): every
-    vertex may move. Returns ``(untangled scene, report)``; ``report.collision_free`` tells
-    whether the result is clean (no crossing, nesting kept, gaps >= 0.9 x required).
+    """Untangles a scene that already crosses (the global mode of ``strata untangle``, without
+    an original): every vertex may move; where the input has a part rolled over an open layer,
+    by the sides inferred per region of it (``report.inferred_sides``) when that comes out
+    clean, else by the global order. Returns ``(untangled scene, report)``;
+    ``report.collision_free`` tells whether the result is clean (no crossing, nesting kept,
+    gaps >= 0.9 x required).
     Parameters (``strata untangle``'s options; None: the library's default): ``backend``
     "indexed" (default), "exact" or "grid"; ``alpha`` 0.8 and ``beta`` 0.9 (shape matching,
     [0, 1]); ``gradient_steps`` 10; ``tolerance`` 1e-6 (relative to the scene diagonal);

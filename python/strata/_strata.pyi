@@ -147,6 +147,7 @@ class UntangleReport:
     crossings_before: int
     crossings_after: int
     min_separation_ratio_after: float
+    inferred_sides: bool  #: The input's rolled regions kept (sides inferred per region).
     @property
     def seconds(self) -> float: ...
 

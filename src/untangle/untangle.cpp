@@ -153,6 +153,29 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
     return run(scene, whole_scene_pieces(scene), params, progress);
 }
 
+UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
+                                        const ProgressFn& progress) {
+    if (params.input_sides && !params.input_sides->empty())
+        return untangle(scene, params, progress);
+    // Regions of the input on the other side of an open layer than the global order says (a
+    // roll, which the global order pushes back): kept there, when that comes out clean.
+    const InputSides inferred = infer_input_sides(scene);
+    UntangleParams with_sides = params;
+    with_sides.outside_sides =
+        params.outside_sides.empty() ? outside_sides(scene) : params.outside_sides;
+    with_sides.input_sides = &inferred;
+    if (inferred.rolled_count(scene, with_sides.outside_sides) > 0) {
+        Scene rolled = scene;
+        UntangleReport report = untangle(rolled, with_sides, progress);
+        if (report.collision_free) {
+            report.inferred_sides = true;
+            scene = std::move(rolled);
+            return report;
+        }
+    }
+    return untangle(scene, params, progress);
+}
+
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,
                               const UntangleParams& params, const ProgressFn& progress) {
     return run(scene, localize(scene, box, n_out), params, progress);

@@ -307,3 +307,42 @@ TEST_CASE("untangle with sides inferred per region keeps a roll (no original at 
     INFO(cut << " of " << runs << " with the bend cut across the other layer");
     CHECK(cut * 10 <= runs);  // the check above must judge most cases
 }
+
+TEST_CASE("untangle_inferring_sides: the inferred sides where the input has rolled regions",
+          "[rolled][untangle]") {
+    for (const RolledCase& c : rolled_cases()) {
+        INFO(c.name);
+        const Scene tangled = naive_decimation(c.input, 0.9, 1);
+        Scene out = tangled;
+        const UntangleReport r = untangle_inferring_sides(out);
+        CHECK(r.collision_free);
+        CHECK(r.inferred_sides);
+        CHECK(r.rolled_vertices > 0);
+        CHECK(r.rolled_kept == r.rolled_vertices);
+        // As untangle() with the sides inferred per region.
+        const InputSides inferred = infer_input_sides(tangled);
+        UntangleParams params;
+        params.outside_sides = outside_sides(tangled);
+        params.input_sides = &inferred;
+        Scene by_hand = tangled;
+        untangle(by_hand, params);
+        CHECK(same_points(out, by_hand));
+        // Against the original's sides: the roll kept.
+        const InputSides sides = InputSides::matched(record_input_sides(c.input), c.input, tangled);
+        if (bend_cut(tangled, sides)) continue;
+        test::require_sides_kept(test::check_with_sides(out, outside_sides(c.input),
+                                                        params.separation_tolerance, &sides),
+                                 0.9);
+        const auto [judged, on_top] = still_on_top(c, tangled, out);
+        CHECK(on_top == judged);
+    }
+    // No rolled region: untangle()'s result.
+    const Scene stack = make_scene(SceneFamily::Stack);
+    const Scene tangled = naive_decimation(stack, 0.9, 1);
+    Scene a = tangled, b = tangled;
+    const UntangleReport ra = untangle(a);
+    const UntangleReport rb = untangle_inferring_sides(b);
+    REQUIRE(ra.collision_free);
+    CHECK_FALSE(rb.inferred_sides);
+    CHECK(same_points(a, b));
+}

@@ -126,6 +126,9 @@ struct UntangleReport {
     /// InputSides::rolled_count()), and of those, the ones still on that side at the end (not a
     /// nesting violation of the final check).
     std::size_t rolled_vertices = 0, rolled_kept = 0;
+    /// untangle_inferring_sides(): the result kept the sides inferred per region of the input
+    /// (infer_input_sides()), which has rolled regions.
+    bool inferred_sides = false;
 };
 
 /// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
@@ -136,6 +139,17 @@ struct UntangleReport {
 /// scene's layer count.  @throws Cancelled.
 UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
                         const ProgressFn& progress = {});
+
+/// @brief untangle() when no original is at hand (what `strata untangle` does by default):
+/// where the input has regions on the other side of an open layer than the global order says
+/// (a part rolled or folded over an open layer, which the global order pushes back), by the
+/// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
+/// rolled; that result is kept when it is clean against those sides (report.inferred_sides).
+/// Otherwise, or when it is not clean, by the global order (untangle() from the input). With
+/// params.input_sides given, this is untangle(). Same params, progress and throws as
+/// untangle().
+UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params = {},
+                                        const ProgressFn& progress = {});
 
 /// @brief Untangles only the vertices of `scene` inside `box`, with collars of `n_out` fixed
 /// vertices (localize()). The fields are built for whole layers here; the simplification
