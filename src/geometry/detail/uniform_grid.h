@@ -80,28 +80,28 @@ class UniformGrid {
     /// Files `id` in the cells `box` touches (an empty box: nowhere).
     void insert(const Id& id, const Box2& box) {
         if (box.is_empty()) return;
-        if (is_large(box)) {
+        const Cells c = cells_of(box);
+        if (is_large(c)) {
             large_.push_back(id);
             return;
         }
-        const long long x0 = column(box.min.x), x1 = column(box.max.x);
-        const long long y0 = row(box.min.y), y1 = row(box.max.y);
-        imin_ = std::min(imin_, x0);
-        imax_ = std::max(imax_, x1);
-        jmin_ = std::min(jmin_, y0);
-        jmax_ = std::max(jmax_, y1);
-        for (long long i = x0; i <= x1; ++i)
-            for (long long j = y0; j <= y1; ++j) slot(i, j).push_back(id);
+        imin_ = std::min(imin_, c.i0);
+        imax_ = std::max(imax_, c.i1);
+        jmin_ = std::min(jmin_, c.j0);
+        jmax_ = std::max(jmax_, c.j1);
+        for (long long i = c.i0; i <= c.i1; ++i)
+            for (long long j = c.j0; j <= c.j1; ++j) slot(i, j).push_back(id);
     }
 
     /// Removes `id`, inserted with `box` (one copy of it from each cell).
     void erase(const Id& id, const Box2& box) {
         if (box.is_empty()) return;
-        if (is_large(box)) {
+        const Cells c = cells_of(box);
+        if (is_large(c)) {
             remove_one(large_, id);
             return;
         }
-        for_cells(box, [&](long long i, long long j) {
+        for_cells(c, [&](long long i, long long j) {
             if (std::vector<Id>* v = find(i, j)) remove_one(*v, id);
         });
     }
@@ -118,7 +118,8 @@ class UniformGrid {
     template <class F>
     void query(const Box2& box, F&& f) const {
         for (const Id& id : large_) f(id);
-        for_cells(box, [&](long long i, long long j) {
+        if (box.is_empty()) return;
+        for_cells(cells_of(box), [&](long long i, long long j) {
             if (const std::vector<Id>* v = find(i, j))
                 for (const Id& id : *v) f(id);
         });
@@ -131,7 +132,8 @@ class UniformGrid {
     void query_once(const Box2& box, BoxOf&& box_of, F&& f) const {
         for (const Id& id : large_)
             if (box_of(id).overlaps(box)) f(id);
-        for_cells(box, [&](long long i, long long j) {
+        if (box.is_empty()) return;
+        for_cells(cells_of(box), [&](long long i, long long j) {
             const std::vector<Id>* v = find(i, j);
             if (!v) return;
             for (const Id& id : *v) {
@@ -236,9 +238,16 @@ class UniformGrid {
     long long column(double x) const { return to_cell((x - params_.origin.x) / params_.cell); }
     long long row(double y) const { return to_cell((y - params_.origin.y) / params_.cell); }
 
-    bool is_large(const Box2& box) const {
-        const double columns = static_cast<double>(column(box.max.x) - column(box.min.x) + 1);
-        const double rows = static_cast<double>(row(box.max.y) - row(box.min.y) + 1);
+    // The cells a box touches: columns i0..i1, rows j0..j1.
+    struct Cells {
+        long long i0, i1, j0, j1;
+    };
+    Cells cells_of(const Box2& box) const {
+        return {column(box.min.x), column(box.max.x), row(box.min.y), row(box.max.y)};
+    }
+    bool is_large(const Cells& c) const {
+        const double columns = static_cast<double>(c.i1 - c.i0 + 1);
+        const double rows = static_cast<double>(c.j1 - c.j0 + 1);
         return !(columns * rows <= params_.max_item_cells);
     }
 
@@ -247,16 +256,13 @@ class UniformGrid {
         imax_ = jmax_ = std::numeric_limits<long long>::min();
     }
 
-    // The occupied cells that `box` touches, column by column, bottom to top.
+    // The occupied ones of cells `c`, column by column, bottom to top.
     template <class F>
-    void for_cells(const Box2& box, F&& f) const {
-        if (box.is_empty()) return;
-        const long long x0 = std::max(column(box.min.x), imin_);
-        const long long x1 = std::min(column(box.max.x), imax_);
-        const long long y0 = std::max(row(box.min.y), jmin_);
-        const long long y1 = std::min(row(box.max.y), jmax_);
-        for (long long i = x0; i <= x1; ++i)
-            for (long long j = y0; j <= y1; ++j) f(i, j);
+    void for_cells(const Cells& c, F&& f) const {
+        const long long i0 = std::max(c.i0, imin_), i1 = std::min(c.i1, imax_);
+        const long long j0 = std::max(c.j0, jmin_), j1 = std::min(c.j1, jmax_);
+        for (long long i = i0; i <= i1; ++i)
+            for (long long j = j0; j <= j1; ++j) f(i, j);
     }
 
     static void remove_one(std::vector<Id>& v, const Id& id) {
