@@ -90,6 +90,17 @@ class Scene {
         return s;
     }
 
+    /// Fills `grid` with `count` new segments by build() (dense cells packed), then checks.
+    void build(Grid& grid, int count) {
+        std::vector<std::uint32_t> ids;
+        for (int k = 0; k < count; ++k) {
+            live_[next_id_] = random_segment();
+            ids.push_back(next_id_++);
+        }
+        grid.build(ids, [&](std::uint32_t id) { return live_.at(id).box(); });
+        check(grid);
+    }
+
     void run(Grid& grid, int steps) {
         for (int step = 0; step < steps; ++step) {
             const int op = static_cast<int>(rng_() % 10);
@@ -203,6 +214,7 @@ TEST_CASE("UniformGrid: box and nearest queries match brute force on random scen
                 static_cast<std::uint32_t>(1000 * cell) + static_cast<std::uint32_t>(layout),
                 layout == 2);
             INFO("cell " << cell << " layout " << layout);
+            if (layout >= 1) scene.build(grid, 300);  // packed, then unpacked by the edits
             scene.run(grid, 1500);
             REQUIRE(scene.live() > 100);
             REQUIRE(grid.memory_bytes() > 0);

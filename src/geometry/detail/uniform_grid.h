@@ -40,7 +40,9 @@ struct UniformGridParams {
 /// Uniform grid of items of type `Id` (a small copyable name, compared with ==), each filed in
 /// the cells its box (scene units) touches. The grid does not store the boxes: erase() takes the
 /// box the item was inserted with. Within a cell the items keep their insertion order, except
-/// that erase() moves the cell's last item into the erased one's place.
+/// that erase() moves the cell's last item into the erased one's place. build() packs the dense
+/// cells into one array (each cell's items side by side, cells in order: what a static index
+/// reads fastest); the first insert() or erase() after it unpacks them.
 template <class Id>
 class UniformGrid {
   public:
@@ -59,22 +61,65 @@ class UniformGrid {
         dense_.resize(static_cast<std::size_t>(nx_ * ny_));
     }
 
+    /// The items of one cell, as read by the queries.
+    struct Items {
+        const Id* first = nullptr;
+        const Id* last = nullptr;
+        const Id* begin() const { return first; }
+        const Id* end() const { return last; }
+        bool empty() const { return first == last; }
+    };
+
     const UniformGridParams& params() const { return params_; }
     double cell() const { return params_.cell; }
 
     /// Empties every cell, keeping the cells and their capacity for the next fill.
     void clear() {
+        if (packed_) {
+            drop_packed();
+            dense_.resize(dense_cells());
+        }
         for (auto& c : dense_) c.clear();
         for (auto& c : hashed_) c.second.clear();
         large_.clear();
         reset_range();
     }
 
-    /// Empties the grid, then inserts every item of `ids` with its box `box_of(id)`.
+    /// Empties the grid, then inserts every item of `ids` with its box `box_of(id)`, the dense
+    /// cells packed (see the class comment).
     template <class BoxOf>
     void build(const std::vector<Id>& ids, BoxOf&& box_of) {
         clear();
-        for (const Id& id : ids) insert(id, box_of(id));
+        if (dense_cells() == 0) {
+            for (const Id& id : ids) insert(id, box_of(id));
+            return;
+        }
+        dense_ = {};
+        start_.assign(dense_cells() + 1, 0);
+        auto each_dense_cell = [&](const Id& id, bool first_pass, auto&& f) {
+            const Box2 box = box_of(id);
+            if (box.is_empty()) return;
+            const Cells c = cells_of(box);
+            if (is_large(c)) {
+                if (first_pass) large_.push_back(id);
+                return;
+            }
+            if (first_pass) extend_range(c);
+            for (long long i = c.i0; i <= c.i1; ++i)
+                for (long long j = c.j0; j <= c.j1; ++j) {
+                    if (in_dense(i, j))
+                        f(dense_index(i, j));
+                    else if (first_pass)
+                        hashed_[key(i, j)].push_back(id);
+                }
+        };
+        for (const Id& id : ids) each_dense_cell(id, true, [&](std::size_t k) { ++start_[k + 1]; });
+        for (std::size_t k = 0; k < dense_cells(); ++k) start_[k + 1] += start_[k];
+        packed_ids_.resize(start_.back());
+        std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
+        for (const Id& id : ids)
+            each_dense_cell(id, false, [&](std::size_t k) { packed_ids_[fill[k]++] = id; });
+        packed_ = true;
     }
 
     /// Files `id` in the cells `box` touches (an empty box: nowhere).
@@ -85,10 +130,8 @@ class UniformGrid {
             large_.push_back(id);
             return;
         }
-        imin_ = std::min(imin_, c.i0);
-        imax_ = std::max(imax_, c.i1);
-        jmin_ = std::min(jmin_, c.j0);
-        jmax_ = std::max(jmax_, c.j1);
+        unpack();
+        extend_range(c);
         for (long long i = c.i0; i <= c.i1; ++i)
             for (long long j = c.j0; j <= c.j1; ++j) slot(i, j).push_back(id);
     }
@@ -101,8 +144,9 @@ class UniformGrid {
             remove_one(large_, id);
             return;
         }
+        unpack();
         for_cells(c, [&](long long i, long long j) {
-            if (std::vector<Id>* v = find(i, j)) remove_one(*v, id);
+            if (std::vector<Id>* v = find_mutable(i, j)) remove_one(*v, id);
         });
     }
 
@@ -120,8 +164,7 @@ class UniformGrid {
         for (const Id& id : large_) f(id);
         if (box.is_empty()) return;
         for_cells(cells_of(box), [&](long long i, long long j) {
-            if (const std::vector<Id>* v = find(i, j))
-                for (const Id& id : *v) f(id);
+            for (const Id& id : find(i, j)) f(id);
         });
     }
 
@@ -133,13 +176,14 @@ class UniformGrid {
         for (const Id& id : large_)
             if (box_of(id).overlaps(box)) f(id);
         if (box.is_empty()) return;
-        for_cells(cells_of(box), [&](long long i, long long j) {
-            const std::vector<Id>* v = find(i, j);
-            if (!v) return;
-            for (const Id& id : *v) {
+        const Cells q = cells_of(box);
+        for_cells(q, [&](long long i, long long j) {
+            for (const Id& id : find(i, j)) {
                 const Box2 b = box_of(id);
-                if (!b.overlaps(box) || column(std::max(b.min.x, box.min.x)) != i ||
-                    row(std::max(b.min.y, box.min.y)) != j)
+                if (!b.overlaps(box)) continue;
+                // The corner's cell; an item starting before the query box, the box's own.
+                if ((b.min.x <= box.min.x ? q.i0 : column(b.min.x)) != i ||
+                    (b.min.y <= box.min.y ? q.j0 : row(b.min.y)) != j)
                     continue;
                 f(id);
             }
@@ -165,7 +209,7 @@ class UniformGrid {
         // Rounding slack of the cell corners (origin + i h) against column() / row().
         const double slack =
             1e-9 * (h + std::abs(x.x) + std::abs(x.y) + std::abs(o.x) + std::abs(o.y));
-        auto offer_cell = [&](long long i, long long j, const std::vector<Id>& v) {
+        auto offer_cell = [&](long long i, long long j, const Items& v) {
             const double lo_x = o.x + static_cast<double>(i) * h - slack;
             const double lo_y = o.y + static_cast<double>(j) * h - slack;
             const double dx = std::max({lo_x - x.x, 0.0, x.x - (lo_x + h + 2.0 * slack)});
@@ -173,12 +217,12 @@ class UniformGrid {
             if (dx * dx + dy * dy > best2) return;
             for (const Id& id : v) best2 = offer(id);
         };
-        const std::size_t budget = dense_.size() + hashed_.size() + 16;
+        const std::size_t budget = dense_cells() + hashed_.size() + 16;
         std::size_t looked_up = 0;
         auto visit = [&](long long i, long long j) {
             ++looked_up;
-            const std::vector<Id>* v = find(i, j);
-            if (v && !v->empty()) offer_cell(i, j, *v);
+            const Items v = find(i, j);
+            if (!v.empty()) offer_cell(i, j, v);
         };
         const long long ci = column(x.x), cj = row(x.y);
         const long long start = std::max({imin_ - ci, ci - imax_, jmin_ - cj, cj - jmax_, 0LL});
@@ -195,10 +239,10 @@ class UniformGrid {
             if (r > 0 && ci + r <= imax_)
                 for (long long j = k0; j <= k1 && looked_up <= budget; ++j) visit(ci + r, j);
             if (looked_up > budget) {
-                for (std::size_t c = 0; c < dense_.size(); ++c)
-                    if (!dense_[c].empty())
+                for (std::size_t c = 0; c < dense_cells(); ++c)
+                    if (const Items v = dense_items(c); !v.empty())
                         offer_cell(x0_ + static_cast<long long>(c) / ny_,
-                                   y0_ + static_cast<long long>(c) % ny_, dense_[c]);
+                                   y0_ + static_cast<long long>(c) % ny_, v);
                 for (const auto& cell : hashed_)  // keys do not hold far cell numbers: no pruning
                     for (const Id& id : cell.second) best2 = offer(id);
                 return;
@@ -219,6 +263,8 @@ class UniformGrid {
     /// Cells, their item lists and the hash table's nodes and bucket array, in bytes.
     std::size_t memory_bytes() const {
         std::size_t bytes = dense_.capacity() * sizeof(std::vector<Id>) +
+                            start_.capacity() * sizeof(std::size_t) +
+                            packed_ids_.capacity() * sizeof(Id) +
                             hashed_.bucket_count() * sizeof(void*) + large_.capacity() * sizeof(Id);
         for (const auto& c : dense_) bytes += c.capacity() * sizeof(Id);
         // One node per hashed cell: key, list and the node's next pointer.
@@ -281,23 +327,57 @@ class UniformGrid {
         return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) |
                static_cast<std::uint64_t>(static_cast<std::uint32_t>(j));
     }
+    std::size_t dense_cells() const { return static_cast<std::size_t>(nx_ * ny_); }
+    std::size_t dense_index(long long i, long long j) const {
+        return static_cast<std::size_t>((i - x0_) * ny_ + (j - y0_));
+    }
+    void extend_range(const Cells& c) {
+        imin_ = std::min(imin_, c.i0);
+        imax_ = std::max(imax_, c.i1);
+        jmin_ = std::min(jmin_, c.j0);
+        jmax_ = std::max(jmax_, c.j1);
+    }
+    void drop_packed() {
+        start_ = {};
+        packed_ids_ = {};
+        packed_ = false;
+    }
+    // The dense cells back in one list each (before an edit).
+    void unpack() {
+        if (!packed_) return;
+        dense_.resize(dense_cells());
+        for (std::size_t k = 0; k < dense_cells(); ++k)
+            dense_[k].assign(packed_ids_.begin() + static_cast<std::ptrdiff_t>(start_[k]),
+                             packed_ids_.begin() + static_cast<std::ptrdiff_t>(start_[k + 1]));
+        drop_packed();
+    }
     std::vector<Id>& slot(long long i, long long j) {
-        if (in_dense(i, j)) return dense_[static_cast<std::size_t>((i - x0_) * ny_ + (j - y0_))];
+        if (in_dense(i, j)) return dense_[dense_index(i, j)];
         return hashed_[key(i, j)];
     }
-    const std::vector<Id>* find(long long i, long long j) const {
-        if (in_dense(i, j)) return &dense_[static_cast<std::size_t>((i - x0_) * ny_ + (j - y0_))];
-        if (hashed_.empty()) return nullptr;
+    Items dense_items(std::size_t k) const {
+        if (packed_) return {packed_ids_.data() + start_[k], packed_ids_.data() + start_[k + 1]};
+        return {dense_[k].data(), dense_[k].data() + dense_[k].size()};
+    }
+    Items find(long long i, long long j) const {
+        if (in_dense(i, j)) return dense_items(dense_index(i, j));
+        if (hashed_.empty()) return {};
+        const auto it = hashed_.find(key(i, j));
+        if (it == hashed_.end()) return {};
+        return {it->second.data(), it->second.data() + it->second.size()};
+    }
+    std::vector<Id>* find_mutable(long long i, long long j) {
+        if (in_dense(i, j)) return &dense_[dense_index(i, j)];
         const auto it = hashed_.find(key(i, j));
         return it == hashed_.end() ? nullptr : &it->second;
-    }
-    std::vector<Id>* find(long long i, long long j) {
-        return const_cast<std::vector<Id>*>(std::as_const(*this).find(i, j));
     }
 
     UniformGridParams params_;
     long long x0_ = 0, y0_ = 0, nx_ = 0, ny_ = 0;  // the dense block of cells (empty: none)
-    std::vector<std::vector<Id>> dense_;
+    std::vector<std::vector<Id>> dense_;           // unpacked dense cells
+    bool packed_ = false;             // the dense cells are start_ / packed_ids_ instead
+    std::vector<std::size_t> start_;  // packed: cell k's items are [start_[k], start_[k+1])
+    std::vector<Id> packed_ids_;
     std::unordered_map<std::uint64_t, std::vector<Id>> hashed_;  // the cells outside it
     std::vector<Id> large_;                                      // items of too many cells
     // Range of the cells occupied since the last clear() (erase() does not shrink it).
