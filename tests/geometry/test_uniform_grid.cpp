@@ -56,6 +56,17 @@ struct Best {
 
 class Scene {
   public:
+    /// A point (x, y) drawn in this order from `fx` then `fy` (coordinates modulo `mod` when
+    /// given): argument evaluation order must not depend on the compiler.
+    template <class Fx, class Fy>
+    Vec2 draw(Fx& fx, Fy& fy, int mod = 0) {
+        const auto x = fx(rng_);
+        const auto y = fy(rng_);
+        if (mod == 0) return Vec2(static_cast<double>(x), static_cast<double>(y));
+        return Vec2(static_cast<double>(static_cast<int>(x) % mod),
+                    static_cast<double>(static_cast<int>(y) % mod));
+    }
+
     /// long_outliers: some segments run from the scene out to a far point (they touch a huge
     /// number of cells: only for a grid that lists large items apart).
     Scene(std::uint32_t seed, bool long_outliers) : rng_(seed), long_outliers_(long_outliers) {}
@@ -66,16 +77,16 @@ class Scene {
         Seg s;
         switch (kind(rng_)) {
             case 0:  // zero length
-                s.a = s.b = Vec2(pos(rng_), pos(rng_));
+                s.a = s.b = draw(pos, pos);
                 break;
             case 1:  // far-away outlier: a point, or a long segment out to it
                 s.a = Vec2(1e6 * (pos(rng_) - 50.0), -3e5);
-                s.b = long_outliers_ && kind(rng_) < 10 ? Vec2(pos(rng_), pos(rng_)) : s.a;
+                s.b = long_outliers_ && kind(rng_) < 10 ? draw(pos, pos) : s.a;
                 break;
             case 2:  // on the lattice (exact ties)
             case 3:
-                s.a = Vec2(lattice(rng_), lattice(rng_));
-                s.b = s.a + Vec2(lattice(rng_) % 3, lattice(rng_) % 3);
+                s.a = draw(lattice, lattice);
+                s.b = s.a + draw(lattice, lattice, 3);
                 break;
             case 4:  // a copy of a live one (same geometry, another id)
                 if (!live_.empty()) {
@@ -84,8 +95,8 @@ class Scene {
                 }
                 [[fallthrough]];
             default:
-                s.a = Vec2(pos(rng_), pos(rng_));
-                s.b = s.a + Vec2(len(rng_), len(rng_));
+                s.a = draw(pos, pos);
+                s.b = s.a + draw(len, len);
         }
         return s;
     }
@@ -131,10 +142,12 @@ class Scene {
             case 0:
                 return Vec2(1e5 * (pos(rng_) - 50.0), 2e5);  // far out
             case 1:
-            case 2:
-                return Vec2(lattice(rng_), lattice(rng_)) + Vec2(0.5 * (lattice(rng_) % 2), 0.0);
+            case 2: {
+                const Vec2 on = draw(lattice, lattice);
+                return on + Vec2(0.5 * (lattice(rng_) % 2), 0.0);
+            }
             default:
-                return Vec2(pos(rng_), pos(rng_));
+                return draw(pos, pos);
         }
     }
 
@@ -145,7 +158,7 @@ class Scene {
             Box2 box;
             const Vec2 c = random_point();
             box.extend(c);
-            box.extend(c + Vec2(size(rng_), size(rng_)));
+            box.extend(c + draw(size, size));
             std::multiset<std::uint32_t> all;
             grid.query(box, [&](std::uint32_t id) { all.insert(id); });
             std::vector<std::uint32_t> once;
