@@ -87,7 +87,11 @@ class SegmentIndex {
     /// Indices of the kept segments, increasing.
     const std::vector<std::size_t>& segments() const { return segments_; }
     Vec2 start(std::size_t s) const { return layer_->segment_start(s); }
-    Vec2 end(std::size_t s) const { return layer_->segment_end(s); }
+    /// layer().segment_end(s) without its modulo (a division: this is the inner loop).
+    Vec2 end(std::size_t s) const {
+        const std::vector<Vec2>& points = layer_->points;
+        return s + 1 < points.size() ? points[s + 1] : points[0];
+    }
     Box2 box(std::size_t s) const {
         Box2 b;
         b.extend(start(s));
@@ -122,8 +126,9 @@ class SegmentIndex {
         Nearest best;
         grid_.nearest(p, cutoff, [&](std::uint32_t id) {
             const std::size_t s = id;
+            const Vec2 a = start(s), b = end(s);
             Vec2 closest;
-            const double d = point_segment_distance(p, start(s), end(s), &closest);
+            const double d = point_segment_distance(p, a, b, &closest);
             if (d < best.distance || (d == best.distance && s < best.segment)) {
                 best.distance = d;
                 best.segment = s;
