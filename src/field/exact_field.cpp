@@ -20,7 +20,8 @@ class ExactField final : public LayerField {
                bool indexed)
         : LayerField(layer.name, layer.closed, outside_sign),
           band_(params.band_width),
-          index_(params.bucket_size, layer.points.empty() ? Vec2(0.0) : layer.bounds().min),
+          index_(make_segment_index(params.bucket_size,
+                                    layer.points.empty() ? Vec2(0.0) : layer.bounds().min)),
           indexed_(indexed) {
         check_points(layer.points, layer.closed, "make_field");
         // Buckets count from the layer's corner: only its size matters, not where it lies.
@@ -30,13 +31,13 @@ class ExactField final : public LayerField {
                                "' is too large for the bucket size");
         store_.build(layer.points, layer.closed, outside_sign);
         set_outside_sign(store_.outside_sign());
-        if (indexed_) index_.build(store_);
+        if (indexed_) index_store(index_, store_);
     }
 
     FieldSample sample(const Vec2& x) const override {
         Nearest best;
         if (indexed_) {
-            index_.search(store_, x, best);
+            nearest_slot(index_, store_, x, best);
         } else {
             const auto& segs = store_.segments();
             for (std::uint32_t s = 0; s < segs.size(); ++s)
@@ -50,7 +51,7 @@ class ExactField final : public LayerField {
     FieldSample sample_in_band(const Vec2& x) const override {
         if (!indexed_) return sample(x);
         Nearest best;
-        index_.search(store_, x, best, band_);
+        nearest_slot(index_, store_, x, best, band_);
         if (!best.found() || !(best.dist2 <= band_ * band_)) {
             FieldSample out;
             out.value = band_;
@@ -65,12 +66,12 @@ class ExactField final : public LayerField {
         std::vector<std::uint32_t> removed, added;
         if (!store_.splice(points, edit, removed, added)) {
             set_outside_sign(store_.outside_sign());
-            if (indexed_) index_.build(store_);
+            if (indexed_) index_store(index_, store_);
             return;
         }
         if (!indexed_) return;
-        for (std::uint32_t s : removed) index_.erase(store_, s);
-        for (std::uint32_t s : added) index_.insert(store_, s);
+        for (std::uint32_t s : removed) erase_slot(index_, store_, s);
+        for (std::uint32_t s : added) insert_slot(index_, store_, s);
     }
 
     FieldStats stats() const override {

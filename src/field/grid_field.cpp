@@ -129,7 +129,7 @@ class GridStack {
             d.name = layer.name;
             d.closed = layer.closed;
             d.store.build(layer.points, layer.closed, outside_signs[l]);
-            d.index.build(d.store);
+            index_store(d.index, d.store);
         }
         build();
     }
@@ -218,7 +218,7 @@ class GridStack {
         if (!d.store.splice(points, edit, removed, added)) {
             // Not local: the store was rebuilt. Recompute the layer's plane in every leaf of its
             // row and in every leaf its new segments reach.
-            d.index.build(d.store);
+            index_store(d.index, d.store);
             std::vector<std::uint64_t> keys;
             const int row_z = row_origin_z(l);
             for (auto it = tree().cbeginLeaf(); it; ++it)
@@ -238,13 +238,13 @@ class GridStack {
             const Segment& seg = d.store.segments()[s];
             for_leaves(seg, [&](std::uint64_t k) { keys.push_back(k); });
             chain.extend(seg.box());
-            d.index.erase(d.store, s);
+            erase_slot(d.index, d.store, s);
         }
         for (std::uint32_t s : added) {
             const Segment& seg = d.store.segments()[s];
             for_leaves(seg, [&](std::uint64_t k) { keys.push_back(k); });
             chain.extend(seg.box());
-            d.index.insert(d.store, s);
+            insert_slot(d.index, d.store, s);
         }
         // A closed layer's sign changes only inside the loop of the old and new chains (which
         // share their end vertices), so within the chain's box: the planes of leaves there where
@@ -375,7 +375,7 @@ class GridStack {
     };
 
     struct LayerData {
-        explicit LayerData(double cell) : index(cell) {}
+        explicit LayerData(double cell) : index(make_segment_index(cell)) {}
         std::string name;
         bool closed = false;
         SegmentStore store;
@@ -528,7 +528,7 @@ class GridStack {
                         static_cast<double>(oj + kLeafDim - 1) * h_));
         // Every segment within band of a voxel centre has a point in the box inflated by the
         // band (one more voxel against rounding), so it is listed in a bucket the box touches.
-        d.index.candidates(box.inflated(band_ + h_), ids);
+        slot_candidates(d.index, box.inflated(band_ + h_), ids);
         // Only those whose box inflated by the band reaches a voxel centre (a margin against
         // rounding): the offers below dominate the build.
         const double reach = band_ + 1e-3 * h_;
@@ -591,7 +591,7 @@ class GridStack {
         const Vec2 p(static_cast<double>(key_i(key) * kLeafDim) * h_,
                      static_cast<double>(key_j(key) * kLeafDim) * h_);
         Nearest best;
-        d.index.search(d.store, p, best);
+        nearest_slot(d.index, d.store, p, best);
         return d.store.evaluate(p, best).value < 0.0 ? -bg : bg;
     }
 

@@ -1,24 +1,16 @@
 #include "strata/geometry/checks.h"
 
+#include "geometry/detail/uniform_grid.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/predicates.h"
 
-// Boost 1.74's Geometry includes one of its own deprecated headers, which prints a note.
-#ifndef BOOST_ALLOW_DEPRECATED_HEADERS
-#define BOOST_ALLOW_DEPRECATED_HEADERS
-#endif
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <boost/geometry/geometries/box.hpp>
-#include <boost/geometry/geometries/point.hpp>
-#include <boost/geometry/index/rtree.hpp>
-#include <boost/geometry/strategies/strategies.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <iterator>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -31,30 +23,44 @@ namespace strata {
 
 namespace {
 
-namespace bg = boost::geometry;
-namespace bgi = boost::geometry::index;
-
-using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
-using BBox = bg::model::box<BPoint>;
-// Broad phases on boxes (exact comparisons); nearest queries in a uniform grid of segments.
-using Entry = std::pair<BBox, std::size_t>;  // a segment's box and its index
-using Tree = bgi::rtree<Entry, bgi::quadratic<16>>;
-
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-BBox segment_box(const Vec2& a, const Vec2& b) {
-    return BBox(BPoint(std::min(a.x, b.x), std::min(a.y, b.y)),
-                BPoint(std::max(a.x, b.x), std::max(a.y, b.y)));
-}
 
 bool lex_less(const Vec2& a, const Vec2& b) {
     return a.x < b.x || (a.x == b.x && a.y < b.y);
 }
 
-// The segments of one layer that take part in the checks, in an rtree. Zero-length segments
-// (left by Scene::set_points, which keeps duplicates) are skipped: their point is an end of
-// their neighbours. A layer all of whose segments have zero length keeps its first one.
+// Cells of a grid over `bounds` for `count` segments of median length `median`: about the
+// median, at most four cells a segment (scene units).
+double cell_size(const Box2& bounds, double median, std::size_t count) {
+    const Vec2 size = bounds.size();
+    double h =
+        std::max({median, 1e-9 * std::max(size.x, size.y), std::numeric_limits<double>::min()});
+    const double budget = 4.0 * static_cast<double>(count) + 16.0;
+    while ((size.x / h + 1.0) * (size.y / h + 1.0) > budget) h *= 2.0;
+    return h;
+}
+
+// A uniform grid for `count` segments within `bounds`, cells dense over them.
+detail::UniformGrid<std::uint32_t> segment_grid(const Box2& bounds, double median,
+                                                std::size_t count) {
+    detail::UniformGridParams p;
+    p.cell = cell_size(bounds, median, count);
+    p.origin = bounds.min;
+    p.dense_bounds = bounds;
+    return detail::UniformGrid<std::uint32_t>(p);
+}
+
+double median_of(std::vector<double>& values) {
+    if (values.empty()) return 0.0;
+    auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), mid, values.end());
+    return *mid;
+}
+
+// The segments of one layer that take part in the checks, in a uniform grid. Zero-length
+// segments (left by Scene::set_points, which keeps duplicates) are skipped: their point is an
+// end of their neighbours. A layer all of whose segments have zero length keeps its first one.
 class SegmentIndex {
   public:
     SegmentIndex() = default;
@@ -65,19 +71,33 @@ class SegmentIndex {
         for (std::size_t s = 0; s < count; ++s)
             if (layer.segment_start(s) != layer.segment_end(s)) add(s);
         if (segments_.empty() && count > 0) add(0);
-        std::vector<Entry> boxes;
-        boxes.reserve(segments_.size());
-        for (std::size_t s : segments_) boxes.emplace_back(segment_box(start(s), end(s)), s);
-        tree_ = Tree(boxes.begin(), boxes.end());  // packing construction
-        build_cells();
+        Box2 bounds;
+        std::vector<double> lengths;
+        std::vector<std::uint32_t> ids;
+        for (std::size_t s : segments_) {
+            bounds.extend(box(s));
+            lengths.push_back(std::hypot(end(s).x - start(s).x, end(s).y - start(s).y));
+            ids.push_back(static_cast<std::uint32_t>(s));
+        }
+        grid_ = segment_grid(bounds, median_of(lengths), segments_.size());
+        grid_.build(ids, [&](std::uint32_t s) { return box(s); });
     }
 
     const Layer& layer() const { return *layer_; }
-    const Tree& tree() const { return tree_; }
     /// Indices of the kept segments, increasing.
     const std::vector<std::size_t>& segments() const { return segments_; }
     Vec2 start(std::size_t s) const { return layer_->segment_start(s); }
-    Vec2 end(std::size_t s) const { return layer_->segment_end(s); }
+    /// layer().segment_end(s) without its modulo (a division: this is the inner loop).
+    Vec2 end(std::size_t s) const {
+        const std::vector<Vec2>& points = layer_->points;
+        return s + 1 < points.size() ? points[s + 1] : points[0];
+    }
+    Box2 box(std::size_t s) const {
+        Box2 b;
+        b.extend(start(s));
+        b.extend(end(s));
+        return b;
+    }
 
     /// The kept segment after / before kept segment `s` (cyclic when closed), or kNone.
     std::size_t next(std::size_t s) const {
@@ -101,30 +121,31 @@ class SegmentIndex {
     };
 
     /// The closest point of the layer to `p` if closer than `cutoff` (the segment of smallest
-    /// index among equally close ones): the cells around p's, ring by ring, until the next
-    /// ring cannot hold anything closer.
+    /// index among equally close ones).
     Nearest nearest(const Vec2& p, double cutoff) const {
         Nearest best;
-        if (segments_.empty()) return best;
-        const long cx = column(p.x), cy = row(p.y);
-        const long rings = static_cast<long>(std::max(nx_, ny_));
-        for (long r = 0; r <= rings; ++r) {
-            // Cells at Chebyshev distance r from (cx, cy) around the clamped start cell.
-            for (long iy = cy - r; iy <= cy + r; ++iy) {
-                if (iy < 0 || iy >= static_cast<long>(ny_)) continue;
-                const bool edge_row = iy == cy - r || iy == cy + r;
-                for (long ix = cx - r; ix <= cx + r; ix += edge_row ? 1 : 2 * r) {
-                    if (ix >= 0 && ix < static_cast<long>(nx_)) visit(ix, iy, p, best);
-                    if (r == 0) break;
-                }
+        grid_.nearest(p, cutoff, [&](std::uint32_t id) {
+            const std::size_t s = id;
+            const Vec2 a = start(s), b = end(s);
+            Vec2 closest;
+            const double d = point_segment_distance(p, a, b, &closest);
+            if (d < best.distance || (d == best.distance && s < best.segment)) {
+                best.distance = d;
+                best.segment = s;
+                best.point = closest;
             }
-            // Every cell not visited yet lies at least r h from p (p, or its projection on the
-            // grid's bounds, is in the start cell).
-            const double reach = static_cast<double>(r) * h_;
-            if (best.distance <= reach || reach >= cutoff) break;
-        }
+            return best.distance * best.distance;
+        });
         if (!(best.distance < cutoff)) return Nearest{};
         return best;
+    }
+
+    /// Calls f(s) once per kept segment s whose box meets `b`.
+    template <class F>
+    void segments_meeting(const Box2& b, F&& f) const {
+        grid_.query_once(
+            b, [&](std::uint32_t s) { return box(s); },
+            [&](std::uint32_t s) { f(static_cast<std::size_t>(s)); });
     }
 
   private:
@@ -133,101 +154,10 @@ class SegmentIndex {
         segments_.push_back(s);
     }
 
-    // A uniform grid over the layer's bounds (about the median segment length, at most four
-    // cells a segment), each kept segment filed in the cells its box meets (compressed rows).
-    void build_cells() {
-        if (segments_.empty()) return;
-        std::vector<double> lengths;
-        for (std::size_t s : segments_) {
-            origin_.extend(start(s));
-            origin_.extend(end(s));
-            lengths.push_back(glm_length(end(s) - start(s)));
-        }
-        auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-        std::nth_element(lengths.begin(), mid, lengths.end());
-        const Vec2 size = origin_.size();
-        h_ = std::max({*mid, 1e-9 * std::max(size.x, size.y),
-                       std::numeric_limits<double>::min()});
-        const double budget = 4.0 * static_cast<double>(segments_.size()) + 16.0;
-        while ((size.x / h_ + 1.0) * (size.y / h_ + 1.0) > budget) h_ *= 2.0;
-        nx_ = static_cast<std::size_t>(size.x / h_) + 1;
-        ny_ = static_cast<std::size_t>(size.y / h_) + 1;
-        cell_start_.assign(nx_ * ny_ + 1, 0);
-        auto each_cell = [&](std::size_t s, auto&& f) {
-            const Vec2 a = start(s), b = end(s);
-            for (long iy = row(std::min(a.y, b.y)); iy <= row(std::max(a.y, b.y)); ++iy)
-                for (long ix = column(std::min(a.x, b.x)); ix <= column(std::max(a.x, b.x)); ++ix)
-                    f(static_cast<std::size_t>(iy) * nx_ + static_cast<std::size_t>(ix));
-        };
-        for (std::size_t s : segments_) each_cell(s, [&](std::size_t c) { ++cell_start_[c + 1]; });
-        for (std::size_t c = 0; c < nx_ * ny_; ++c) cell_start_[c + 1] += cell_start_[c];
-        cell_ids_.resize(cell_start_.back());
-        std::vector<std::size_t> fill(cell_start_.begin(), cell_start_.end() - 1);
-        for (std::size_t s : segments_) each_cell(s, [&](std::size_t c) { cell_ids_[fill[c]++] = s; });
-        // Boxes of kChunk consecutive entries (a chunk may run into the next cell: its box then
-        // holds more, still a lower bound for each of its segments). A cell holds many entries
-        // where the grid is coarse for its layer (a long dense curve in a large box: the cell
-        // count is bounded by 4 a segment), and whole chunks are then skipped.
-        chunk_boxes_.assign((cell_ids_.size() + kChunk - 1) / kChunk, Box2{});
-        for (std::size_t k = 0; k < cell_ids_.size(); ++k) {
-            chunk_boxes_[k / kChunk].extend(start(cell_ids_[k]));
-            chunk_boxes_[k / kChunk].extend(end(cell_ids_[k]));
-        }
-    }
-    static double glm_length(const Vec2& v) { return std::hypot(v.x, v.y); }
-    long column(double x) const { return clamp_cell((x - origin_.min.x) / h_, nx_); }
-    long row(double y) const { return clamp_cell((y - origin_.min.y) / h_, ny_); }
-    static long clamp_cell(double v, std::size_t n) {
-        if (!(v > 0.0)) return 0;  // NaN too
-        return static_cast<long>(std::min(v, static_cast<double>(n - 1)));
-    }
-    void visit(long ix, long iy, const Vec2& p, Nearest& best) const {
-        const std::size_t c = static_cast<std::size_t>(iy) * nx_ + static_cast<std::size_t>(ix);
-        if (cell_start_[c] == cell_start_[c + 1]) return;
-        // Nothing in a cell farther than the best so far can beat it.
-        const double x0 = origin_.min.x + static_cast<double>(ix) * h_;
-        const double y0 = origin_.min.y + static_cast<double>(iy) * h_;
-        const double dx = std::max({x0 - p.x, 0.0, p.x - (x0 + h_)});
-        const double dy = std::max({y0 - p.y, 0.0, p.y - (y0 + h_)});
-        if (dx * dx + dy * dy > best.distance * best.distance) return;
-        // The entries go by chunks of kChunk, each skipped whole when its box is farther than
-        // the best so far (slack 1e-12: rounding never skips a segment that could win).
-        const std::size_t end_entry = cell_start_[c + 1];
-        const bool by_chunks = end_entry - cell_start_[c] > 4 * kChunk;  // else plain
-        for (std::size_t k = cell_start_[c]; k < end_entry;) {
-            const std::size_t chunk = k / kChunk;
-            const std::size_t chunk_end =
-                by_chunks ? std::min(end_entry, (chunk + 1) * kChunk) : end_entry;
-            const Box2& box = chunk_boxes_[chunk];
-            const double bx = std::max({box.min.x - p.x, 0.0, p.x - box.max.x});
-            const double by = std::max({box.min.y - p.y, 0.0, p.y - box.max.y});
-            if (by_chunks && bx * bx + by * by > best.distance * best.distance * (1.0 + 1e-12)) {
-                k = chunk_end;
-                continue;
-            }
-            for (; k < chunk_end; ++k) {
-                const std::size_t s = cell_ids_[k];
-                Vec2 closest;
-                const double d = point_segment_distance(p, start(s), end(s), &closest);
-                if (d < best.distance || (d == best.distance && s < best.segment)) {
-                    best.distance = d;
-                    best.segment = s;
-                    best.point = closest;
-                }
-            }
-        }
-    }
-
     const Layer* layer_ = nullptr;
     std::vector<std::size_t> segments_;
     std::vector<std::size_t> position_;
-    Tree tree_;
-    Box2 origin_;  // the grid's bounds
-    double h_ = 1.0;
-    std::size_t nx_ = 1, ny_ = 1;
-    std::vector<std::size_t> cell_start_, cell_ids_;
-    static constexpr std::size_t kChunk = 8;
-    std::vector<Box2> chunk_boxes_;  // entries [kChunk j, kChunk (j + 1)) of cell_ids_
+    detail::UniformGrid<std::uint32_t> grid_;
 };
 
 using Nearest = SegmentIndex::Nearest;
@@ -310,18 +240,26 @@ enum class Placement { Inside, Outside, OnBoundary };
 // Exact placement of `v` with respect to the closed layer of `index` (non-zero winding rule).
 Placement placement(const SegmentIndex& index, const Box2& bounds, const Vec2& v) {
     if (!bounds.contains(v)) return Placement::Outside;
-    std::vector<Entry> hits;
-    index.tree().query(bgi::intersects(BBox(BPoint(v.x, v.y), BPoint(bounds.max.x, v.y))),
-                       std::back_inserter(hits));
+    // A ray from v to the nearer of the left and right sides of the bounds: to the left, the
+    // winding number of the layer mirrored by x -> -x (exact; its sign changes, not whether
+    // it is zero).
+    const bool leftwards = v.x - bounds.min.x < bounds.max.x - v.x;
+    const double sign = leftwards ? -1.0 : 1.0;
+    auto seen = [sign](const Vec2& p) { return Vec2(sign * p.x, p.y); };
+    Box2 ray;
+    ray.extend(v);
+    ray.extend(Vec2(leftwards ? bounds.min.x : bounds.max.x, v.y));
     long winding = 0;
-    for (const Entry& e : hits) {
-        const Vec2 p = index.start(e.second), q = index.end(e.second);
+    bool on_boundary = false;
+    index.segments_meeting(ray, [&](std::size_t s) {
+        const Vec2 p = index.start(s), q = index.end(s);
         const int o = orient2d(p, q, v);
         if (o == 0 && std::min(p.x, q.x) <= v.x && v.x <= std::max(p.x, q.x) &&
             std::min(p.y, q.y) <= v.y && v.y <= std::max(p.y, q.y))
-            return Placement::OnBoundary;
-        winding += winding_contribution(p, q, v);
-    }
+            on_boundary = true;
+        winding += winding_contribution(seen(p), seen(q), seen(v));
+    });
+    if (on_boundary) return Placement::OnBoundary;
     return winding != 0 ? Placement::Inside : Placement::Outside;
 }
 
@@ -426,31 +364,40 @@ class Checker {
     }
 
     void find_contacts() {
-        // One rtree over the kept segments of every layer; ids follow (layer, segment) order.
+        // One grid over the kept segments of every layer; ids follow (layer, segment) order.
         std::vector<std::pair<std::size_t, std::size_t>> owner;
-        std::vector<Entry> entries;
+        std::vector<Box2> boxes;
+        std::vector<double> lengths;
+        Box2 all;
         for (std::size_t i = 0; i < n_; ++i)
             for (std::size_t s : indices_[i].segments()) {
-                entries.emplace_back(segment_box(indices_[i].start(s), indices_[i].end(s)),
-                                     owner.size());
                 owner.emplace_back(i, s);
+                boxes.push_back(indices_[i].box(s));
+                all.extend(boxes.back());
+                const Vec2 d = indices_[i].end(s) - indices_[i].start(s);
+                lengths.push_back(std::hypot(d.x, d.y));
             }
-        const Tree tree(entries.begin(), entries.end());
+        std::vector<std::uint32_t> ids(owner.size());
+        for (std::size_t id = 0; id < ids.size(); ++id) ids[id] = static_cast<std::uint32_t>(id);
+        detail::UniformGrid<std::uint32_t> grid =
+            segment_grid(all, median_of(lengths), owner.size());
+        auto box_of = [&](std::uint32_t id) { return boxes[id]; };
+        grid.build(ids, box_of);
 
         const std::size_t cap = params_.max_listed;
         std::vector<Contact> proper_cross, proper_self, touches;
-        std::vector<Entry> hits;
+        std::vector<std::uint32_t> hits;
         for (std::size_t id = 0; id < owner.size(); ++id) {
             const auto [i, s] = owner[id];
             const SegmentIndex& a = indices_[i];
             const Vec2 p0 = a.start(s), p1 = a.end(s);
             hits.clear();
-            tree.query(bgi::intersects(segment_box(p0, p1)), std::back_inserter(hits));
-            std::sort(hits.begin(), hits.end(),
-                      [](const Entry& x, const Entry& y) { return x.second < y.second; });
-            for (const Entry& hit : hits) {
-                if (hit.second <= id) continue;
-                const auto [j, t] = owner[hit.second];
+            grid.query_once(boxes[id], box_of, [&](std::uint32_t hit) {
+                if (hit > id) hits.push_back(hit);
+            });
+            std::sort(hits.begin(), hits.end());
+            for (const std::uint32_t hit : hits) {
+                const auto [j, t] = owner[hit];
                 const SegmentIndex& b = indices_[j];
                 const Vec2 q0 = b.start(t), q1 = b.end(t);
                 if (i == j && (a.next(s) == t || a.next(t) == s)) {
@@ -886,8 +833,7 @@ InputSides record_input_sides(const Scene& scene, const InputSideParams& params)
     return out;
 }
 
-InputSides InputSides::from_codes(const Scene& scene,
-                                  std::vector<std::vector<signed char>> codes) {
+InputSides InputSides::from_codes(const Scene& scene, std::vector<std::vector<signed char>> codes) {
     auto r = std::make_shared<InputSides::Recorded>();
     r->scene = scene;
     const std::size_t n = scene.size();

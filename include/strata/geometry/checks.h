@@ -124,12 +124,12 @@ struct CheckReport {
 /// not checked against open layers. With params.input_sides, a vertex with a recorded side of
 /// an open layer is checked against that side instead of the global one.
 ///
-/// Cost: an rtree broad phase for the contacts, O((n + k) log n) for n segments and k
-/// contacts; a nearest-segment query in a per-layer uniform grid per vertex and near layer
-/// (one query serves both the separation and, against an open layer, the side); one
-/// point-in-polygon ray query per vertex and closed layer whose box holds it. Pairs of layers
-/// are scanned in parallel (TBB, within the caller's max_allowed_parallelism); the report
-/// does not depend on the number of threads.
+/// Cost: a uniform-grid broad phase for the contacts, about O(n + k) for n segments of
+/// similar lengths and k contacts; a nearest-segment query in a per-layer uniform grid per
+/// vertex and near layer (one query serves both the separation and, against an open layer,
+/// the side); one point-in-polygon ray query per vertex and closed layer whose box holds it.
+/// Pairs of layers are scanned in parallel (TBB, within the caller's
+/// max_allowed_parallelism); the report does not depend on the number of threads.
 /// @throws InvalidInput bad params.
 CheckReport check_scene(const Scene& scene, const CheckParams& params = {});
 
@@ -169,7 +169,7 @@ struct HausdorffDistance {
 /// An interval [p0, p1] of a segment is bounded by (d0 + d1 + |p1 - p0|) / 2 and by
 /// max(d(p0, s), d(p1, s)) for the segments s of the other polyline nearest to p0 and p1
 /// (the distance to one segment is convex along a line), and split until within tolerance.
-/// Nearest queries use an rtree of the other polyline's segments.
+/// Nearest queries use a uniform grid of the other polyline's segments.
 ///
 /// Each returned value is a lower bound that is achieved (the distance of an evaluated point
 /// of one polyline to the other); the true value is at most that plus `tolerance`. Vertices

@@ -1,65 +1,70 @@
 #pragma once
-/// @file Internal: uniform buckets over a SegmentStore's slots and the exact nearest-segment
-/// search through them (the ExactIndexed backend; the Grid backend's voxel values and
-/// out-of-band signs).
+/// @file Internal: the field backends' spatial index of a SegmentStore's live slots (a
+/// UniformGrid of slot numbers) and the exact nearest-segment search through it (the
+/// ExactIndexed backend; the Grid backend's voxel values and out-of-band signs).
 
 #include "field/detail/segment_store.h"
+#include "geometry/detail/uniform_grid.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <unordered_map>
 #include <vector>
 
 namespace strata::detail {
 
-/// Square buckets of side `cell` (scene units) listing the live slots whose bounding box
-/// touches them; a slot whose box would touch more than kMaxCells buckets (a vertex carried
-/// far away) is kept in a plain list that every query reads instead, so that memory stays
-/// bounded. The store is not owned: pass the same one to every call.
-class SegmentIndex {
-  public:
-    /// Buckets counted from `origin` (e.g. the layer's corner: far from the scene origin,
-    /// bucket numbers stay small).
-    explicit SegmentIndex(double cell = 1.0, const Vec2& origin = Vec2(0.0))
-        : cell_(cell), origin_(origin) {}
+/// A store's live slots filed by their boxes. The store is not owned: pass the same one to
+/// every call.
+using SegmentIndex = UniformGrid<std::uint32_t>;
 
-    /// Indexes every live slot of `store` (replaces the current content).
-    void build(const SegmentStore& store);
-    /// Adds / removes one slot (its geometry as it is in the store now / was when inserted).
-    void insert(const SegmentStore& store, std::uint32_t slot);
-    void erase(const SegmentStore& store, std::uint32_t slot);
+/// Buckets a slot may touch before it goes to the grid's list of large items.
+constexpr double kMaxSlotCells = 4096.0;
 
-    /// Rings of buckets around x, clipped to the occupied ones, until no unvisited segment can be
-    /// as near as the best one (ties included, so the winner is the brute-force one), or, when
-    /// nothing within `limit` (scene units) has been found, none can be within `limit` either.
-    void search(const SegmentStore& store, const Vec2& x, Nearest& best,
-                double limit = std::numeric_limits<double>::infinity()) const;
+/// An empty index of square cells of side `cell` (scene units) counted from `origin` (e.g. the
+/// layer's corner: far from the scene origin, cell numbers stay small).
+inline SegmentIndex make_segment_index(double cell, const Vec2& origin = Vec2(0.0)) {
+    UniformGridParams p;
+    p.cell = cell;
+    p.origin = origin;
+    p.max_item_cells = kMaxSlotCells;
+    return SegmentIndex(p);
+}
 
-    /// The slots listed in the buckets that `box` touches, sorted, without repeats (`out` is
-    /// replaced): a superset of the segments that have a point in `box`.
-    void candidates(const Box2& box, std::vector<std::uint32_t>& out) const;
+/// Adds slot `slot` of `store` if live (its geometry as it is in the store now).
+inline void insert_slot(SegmentIndex& index, const SegmentStore& store, std::uint32_t slot) {
+    const Segment& s = store.segments()[slot];
+    if (s.live) index.insert(slot, s.box());
+}
 
-    /// Buckets, their slot lists and the hash table's nodes and bucket array, in bytes.
-    std::size_t memory_bytes() const;
+/// Removes slot `slot` (its geometry as it was when inserted, still in the store).
+inline void erase_slot(SegmentIndex& index, const SegmentStore& store, std::uint32_t slot) {
+    index.erase(slot, store.segments()[slot].box());
+}
 
-    /// Buckets a slot may touch before it goes to the plain list.
-    static constexpr double kMaxCells = 4096.0;
+/// Indexes every live slot of `store` (replaces the content of `index`, cells included).
+inline void index_store(SegmentIndex& index, const SegmentStore& store) {
+    index = SegmentIndex(index.params());
+    for (std::uint32_t s = 0; s < store.segments().size(); ++s) insert_slot(index, store, s);
+}
 
-  private:
-    bool is_large(const Box2& box) const;
-    long column(double x) const;
-    long row(double y) const;
-    template <typename F>
-    void for_cells(const Box2& box, F&& f) const;
-    void visit(const SegmentStore& store, const Vec2& x, long i, long j, Nearest& best) const;
+/// The nearest live slot to x into `best` (store.offer()'s tie-break, so the brute-force
+/// winner), or, when nothing is within `limit` (scene units), possibly none.
+inline void nearest_slot(const SegmentIndex& index, const SegmentStore& store, const Vec2& x,
+                         Nearest& best, double limit = std::numeric_limits<double>::infinity()) {
+    index.nearest(x, limit, [&](std::uint32_t s) {
+        store.offer(x, s, best);
+        return best.dist2;
+    });
+}
 
-    double cell_ = 1.0;
-    Vec2 origin_{0.0};
-    std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> buckets_;
-    std::vector<std::uint32_t> large_;  // slots too large for the buckets
-    // Bounding range of the buckets ever occupied since the last build (not shrunk by erase).
-    long imin_ = std::numeric_limits<long>::max(), imax_ = std::numeric_limits<long>::min();
-    long jmin_ = std::numeric_limits<long>::max(), jmax_ = std::numeric_limits<long>::min();
-};
+/// The slots filed in the cells that `box` touches, sorted, without repeats (`out` is
+/// replaced): a superset of the segments that have a point in `box`.
+inline void slot_candidates(const SegmentIndex& index, const Box2& box,
+                            std::vector<std::uint32_t>& out) {
+    out.clear();
+    index.query(box, [&](std::uint32_t s) { out.push_back(s); });
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+}
 
 }  // namespace strata::detail

@@ -196,7 +196,7 @@ void JobRunner::local_sides(Job& job) const {
 }
 
 void JobRunner::execute(Job& job) const {
-    SegmentGrid moving(live_.grid().cell());
+    SegmentGrid moving = make_segment_grid(live_.grid().cell());
     // A result that carries a vertex out of the job's neighbourhood is no local fix: refused
     // (filing its segments would also touch an unbounded number of grid cells).
     const Vec2 size = job.footprint.size();

@@ -9,7 +9,7 @@
 namespace strata::detail {
 
 LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>& targets)
-    : grid_(1.0) {
+    : grid_(make_segment_grid(1.0)) {
     const std::size_t n = scene.size();
     layers_.resize(n);
     std::vector<double> lengths;
@@ -39,8 +39,8 @@ LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>&
     const double median = lengths.empty() ? 1.0 : lengths[lengths.size() / 2];
     std::size_t segments = 0;
     for (std::size_t l = 0; l < n; ++l) segments += scene.layer(l).segment_count();
-    grid_ = SegmentGrid(std::max(4.0 * median, std::numeric_limits<double>::min()), scene.bounds(),
-                        segments);
+    grid_ = make_segment_grid(std::max(4.0 * median, std::numeric_limits<double>::min()),
+                              scene.bounds(), segments);
     for (std::size_t l = 0; l < n; ++l)
         for (std::size_t i = 0; i < layers_[l].alive.size(); ++i)
             if (has_segment(l, i)) grid_.insert(ref(l, i), seg_box(l, i));
