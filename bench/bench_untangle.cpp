@@ -18,7 +18,7 @@
 // moved vertices, the largest Hausdorff distance of a layer to its un-decimated input.
 // Usage: strata_bench_untangle [--family NAME] [--tangle naive90|naive95|dp]
 //                              [--backend indexed|grid] [--points N] [--timing] [--write DIR]
-//                              [--sides | --global-order]
+//                              [--sides | --global-order] [--unrolled]
 // --write DIR: every case's generated input (NAME.input.json), tangled input
 // (NAME.tangled.json) and result (NAME.json, and
 // NAME.svg with the tangled input drawn faintly under it), DIR existing.
@@ -31,6 +31,9 @@
 // its sides of the open layers are given to untangle() (UntangleParams::input_sides,
 // outside_sides). Real slices are untangled as without it (their input is the tangle).
 // --global-order: untangle() by the global order alone (`strata untangle --global-order`).
+// --unrolled: the rolled families' counterparts that keep the global order
+// (FamilyParams::unrolled; named NAME_unrolled), e.g. to time `strata simplify` on the same
+// scene without its roll.
 
 #include "strata/core/error.h"
 #include "strata/core/progress.h"
@@ -116,14 +119,18 @@ struct Case {
     Scene input;
 };
 
+bool unrolled = false;  // --unrolled
+
 std::vector<Case> cases(std::size_t points, const std::string& only) {
     std::vector<Case> out;
     for (SceneFamily family : all_scene_families()) {
         FamilyParams p;
         p.points = points;
         p.layers = family == SceneFamily::Folded ? 4 : 6;
-        const std::string name = family_name(family);
-        if (only.empty() || only == name) out.push_back({name, make_scene(family, p)});
+        p.unrolled = unrolled && is_rolled(family);
+        const std::string name = family_name(family) + (p.unrolled ? "_unrolled" : "");
+        if (only.empty() || only == family_name(family))
+            out.push_back({name, make_scene(family, p)});
         if (family != SceneFamily::Stack && family != SceneFamily::Loops) continue;
         if (!only.empty() && only != name && only != "scaled") continue;
         FamilyParams small = p, large = p, far = p;
@@ -274,12 +281,14 @@ int main(int argc, char** argv) {
             keep_sides = true;
         else if (key == "--global-order")
             global_order = true;
+        else if (key == "--unrolled")
+            unrolled = true;
         else {
-            std::fprintf(
-                stderr,
-                "usage: strata_bench_untangle [--family NAME] [--tangle "
-                "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
-                "[--timing] [--write DIR] [--slices DIR|none] [--sides | --global-order]\n");
+            std::fprintf(stderr,
+                         "usage: strata_bench_untangle [--family NAME] [--tangle "
+                         "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
+                         "[--timing] [--write DIR] [--slices DIR|none] [--sides | --global-order] "
+                         "[--unrolled]\n");
             return 2;
         }
     }

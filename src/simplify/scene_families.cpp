@@ -125,6 +125,8 @@ std::vector<Layer> rolled(const FamilyParams& p) {
         inner.points.emplace_back(9.0 + r * std::cos(a), r + r * std::sin(a));
     }
     for (double x = 9.0 - s; x >= 5.0; x -= s) inner.points.emplace_back(x, 3.0 * gap);
+    if (p.unrolled)  // the roll turned away from the outer layer, below the inner one's base
+        for (Vec2& q : inner.points) q.y = -q.y;
     return {inner, outer};
 }
 
@@ -135,13 +137,18 @@ std::vector<Layer> rolled_twice(const FamilyParams& p) {
     std::vector<Layer> layers = rolled(p);
     const double s = 10.0 / static_cast<double>(p.points - 1), gap = p.gap * s;
     Layer& inner = layers[0];
-    const Vec2 end = inner.points.back();  // about (5, 3 gap)
+    Vec2 end = inner.points.back();  // about (5, 3 gap)
+    end.y = std::abs(end.y);
+    const std::size_t before = inner.points.size();
     const int steps = std::max(4, static_cast<int>(std::ceil(kPi * gap / s)));
     for (int j = 1; j <= steps; ++j) {
         const double a = -0.5 * kPi - kPi * j / steps;  // around (x_end, 4 gap), on the left
         inner.points.emplace_back(end.x + gap * std::cos(a), 4.0 * gap + gap * std::sin(a));
     }
     for (double x = end.x + s; x <= 8.0 + 1e-9; x += s) inner.points.emplace_back(x, 5.0 * gap);
+    if (p.unrolled)  // rolled() mirrored its first part already: mirror what was added here
+        for (std::size_t k = before; k < inner.points.size(); ++k)
+            inner.points[k].y = -inner.points[k].y;
     return layers;
 }
 
@@ -184,8 +191,9 @@ std::vector<Layer> shirt_roll(const FamilyParams& p) {
     coat.outer = std::vector<std::string>{};
     for (std::size_t i = 0; i < p.points; ++i)
         body.points.push_back(at(1.0, s * static_cast<double>(i)));
+    const double shift = p.unrolled ? 1.0 : 0.0;  // unrolled: the jacket ends before the roll
     for (double t = 0.5; t <= 5.0 - 4.0 * gap + 1e-12; t += s)
-        coat.points.push_back(at(1.0 + 2.0 * gap, t));
+        coat.points.push_back(at(1.0 + 2.0 * gap, t - shift));
     for (double t = 0.5; t < 5.0; t += s) shirt.points.push_back(at(1.0 + gap, t));
     const int steps = std::max(4, static_cast<int>(std::ceil(kPi * gap / s)));
     const Vec2 centre = at(1.0 + 2.0 * gap, 5.0), radial = at(1.0, 5.0),
@@ -196,6 +204,61 @@ std::vector<Layer> shirt_roll(const FamilyParams& p) {
     }
     for (double t = 5.0 - s; t >= 4.0; t -= s) shirt.points.push_back(at(1.0 + 3.0 * gap, t));
     return {body, shirt, coat};
+}
+
+// Collar wrap: a collar folded over a closed cord, over a closed body. Body radius 1
+// (`points` vertices, under the collar); the collar at 1 + gap over the angles [0.5, 5] turns
+// outward at angle 5 around a half circle of radius 1.5 gap and comes back at 1 + 4 gap to
+// angle 4; the cord, a closed loop of half width 0.9 gap (thickness a quarter gap: 0.6 gap
+// from the collar for 0.375 required) along the radius 1 + 2.5 gap over the angles [4.2, 5],
+// fills the fold like a drawstring in its channel. The cord is under the collar (the only
+// order a closed layer wrapped by an open one can have: the collar cannot be inside it), but
+// it lies on the collar's outside face all along: over the collar's first part, and under its
+// turned-back part, whose outside faces inward.
+std::vector<Layer> collar_wrap(const FamilyParams& p) {
+    const double s = 2.0 * kPi / static_cast<double>(p.points), gap = p.gap * s;
+    auto at = [](double r, double t) { return Vec2(r * std::cos(t), r * std::sin(t)); };
+    Layer body = make_layer("body", 0.5 * gap, true), collar = make_layer("collar", 0.5 * gap),
+          cord = make_layer("cord", 0.25 * gap, true);
+    body.outer = std::vector<std::string>{"collar"};
+    cord.outer = std::vector<std::string>{"collar"};
+    collar.outer = std::vector<std::string>{};
+    for (std::size_t i = 0; i < p.points; ++i)
+        body.points.push_back(at(1.0, s * static_cast<double>(i)));
+    // An arc of radius r from angle t0 to t1 (t1 excluded) in steps of about one segment at
+    // radius r_steps.
+    auto arc = [&](Layer& layer, double r, double t0, double t1, double r_steps) {
+        const int steps =
+            std::max(1, static_cast<int>(std::round(std::abs(t1 - t0) * r_steps / s)));
+        for (int j = 0; j < steps; ++j) layer.points.push_back(at(r, t0 + (t1 - t0) * j / steps));
+    };
+    // Half a turn of radius r about the point at radius `mid`, angle t, from radius mid - r to
+    // mid + r (outward = +1) or back (-1), bulging forward (+1, toward larger angles) or
+    // backward (-1); the end point excluded.
+    auto half_turn = [&](Layer& layer, double mid, double t, double r, double outward,
+                         double forward) {
+        const int steps = std::max(4, static_cast<int>(std::ceil(kPi * r / s)));
+        const Vec2 centre = at(mid, t), radial = at(1.0, t), along = at(1.0, t + 0.5 * kPi);
+        for (int j = 0; j < steps; ++j) {
+            const double a = kPi * j / steps;
+            layer.points.push_back(centre - outward * r * std::cos(a) * radial +
+                                   forward * r * std::sin(a) * along);
+        }
+    };
+    const double fold = 1.5 * gap, rho = 0.9 * gap;  // the fold's and the cord's half widths
+    arc(collar, 1.0 + gap, 0.5, 5.0, 1.0 + gap);
+    half_turn(collar, 1.0 + gap + fold, 5.0, fold, 1.0, 1.0);
+    arc(collar, 1.0 + gap + 2.0 * fold, 5.0, 4.0, 1.0 + gap + 2.0 * fold);
+    collar.points.push_back(at(1.0 + gap + 2.0 * fold, 4.0));
+    // Unrolled: the cord outside the turned-back part, as far from it as inside the fold
+    // (with as many vertices).
+    const double wrapped = 1.0 + gap + fold, from = 4.2;
+    const double mid = p.unrolled ? wrapped + 2.0 * fold : wrapped;
+    arc(cord, mid - rho, from, 5.0, wrapped - rho);
+    half_turn(cord, mid, 5.0, rho, 1.0, 1.0);
+    arc(cord, mid + rho, 5.0, from, wrapped + rho);
+    half_turn(cord, mid, from, rho, -1.0, -1.0);
+    return {body, cord, collar};
 }
 
 // Jacket: a body loop r = 1 + 0.02 sin 5t and, gap outside it, an open jacket over the
@@ -264,7 +327,8 @@ std::vector<Layer> legs(const FamilyParams& p) {
 std::vector<SceneFamily> all_scene_families() {
     return {SceneFamily::Stack,       SceneFamily::Loops,      SceneFamily::Folded,
             SceneFamily::Rolled,      SceneFamily::Jacket,     SceneFamily::Legs,
-            SceneFamily::RolledTwice, SceneFamily::RolledBoth, SceneFamily::ShirtRoll};
+            SceneFamily::RolledTwice, SceneFamily::RolledBoth, SceneFamily::ShirtRoll,
+            SceneFamily::CollarWrap};
 }
 
 std::string family_name(SceneFamily family) {
@@ -287,6 +351,8 @@ std::string family_name(SceneFamily family) {
             return "rolled_both";
         case SceneFamily::ShirtRoll:
             return "shirt_roll";
+        case SceneFamily::CollarWrap:
+            return "collar_wrap";
     }
     return "?";
 }
@@ -295,7 +361,7 @@ bool is_rolled(SceneFamily family) {
     // RolledBoth keeps it: on top both layers run back, so the side of the outer one that the
     // inner one lies on, taken along its direction of travel, is the same as below.
     return family == SceneFamily::Rolled || family == SceneFamily::RolledTwice ||
-           family == SceneFamily::ShirtRoll;
+           family == SceneFamily::ShirtRoll || family == SceneFamily::CollarWrap;
 }
 
 Scene make_scene(SceneFamily family, const FamilyParams& params) {
@@ -338,6 +404,9 @@ Scene make_scene(SceneFamily family, const FamilyParams& params) {
             break;
         case SceneFamily::ShirtRoll:
             layers = shirt_roll(params);
+            break;
+        case SceneFamily::CollarWrap:
+            layers = collar_wrap(params);
             break;
     }
     for (Layer& layer : layers) {

@@ -5,6 +5,7 @@
 #include "strata/untangle/untangle.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <catch2/catch.hpp>
 
@@ -38,6 +39,41 @@ TEST_CASE("every generated family is a valid, untangled scene with its gaps", "[
             }
         }
     }
+}
+
+TEST_CASE("the unrolled counterparts keep the global order with as many vertices", "[families]") {
+    std::size_t rolled_families = 0;
+    for (SceneFamily family : all_scene_families()) {
+        if (!is_rolled(family)) continue;
+        ++rolled_families;
+        for (double gap : {0.5, 2.0, 4.0}) {
+            INFO(family_name(family) << " gap " << gap);
+            FamilyParams params;
+            params.points = 300;
+            params.gap = gap;
+            const Scene rolled = make_scene(family, params);
+            params.unrolled = true;
+            const Scene unrolled = make_scene(family, params);
+            REQUIRE(unrolled.size() == rolled.size());
+            for (std::size_t l = 0; l < rolled.size(); ++l) {
+                CHECK(unrolled.layer(l).name == rolled.layer(l).name);
+                CHECK(unrolled.layer(l).closed == rolled.layer(l).closed);
+                const double n = static_cast<double>(rolled.layer(l).points.size());
+                CHECK(std::abs(static_cast<double>(unrolled.layer(l).points.size()) - n) <=
+                      0.02 * n + 1.0);
+            }
+            const CheckReport check = check_scene(unrolled);
+            CHECK(check.crossing_count == 0);
+            CHECK(check.total_self_crossings() == 0);
+            CHECK(check.nesting_violation_count == 0);
+            CHECK(check.min_separation_ratio >= 0.9);
+            CHECK(record_input_sides(unrolled).rolled_count(unrolled, outside_sides(unrolled)) ==
+                  0);
+            // The rolled one does break the global order (else the pair compares nothing).
+            CHECK(check_scene(rolled).nesting_violation_count > 0);
+        }
+    }
+    CHECK(rolled_families == 4);
 }
 
 TEST_CASE("generated families scale and shift exactly", "[families]") {

@@ -55,6 +55,15 @@ inline Scene shirt_rolled_over_jacket(std::size_t points, double gap_in_segments
     return make_scene(SceneFamily::ShirtRoll, p);
 }
 
+/// make_scene(SceneFamily::CollarWrap) with `points` and `gap_in_segments`: a collar folded
+/// around a closed cord over a closed body (layers body, cord, collar).
+inline Scene collar_wrapped_cord(std::size_t points, double gap_in_segments) {
+    FamilyParams p;
+    p.points = points;
+    p.gap = gap_in_segments;
+    return make_scene(SceneFamily::CollarWrap, p);
+}
+
 /// tests/data/<name>
 std::filesystem::path test_data(const std::string& name);
 /// ../shared/data/<name> beside the project, or empty when that folder is absent.

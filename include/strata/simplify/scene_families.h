@@ -26,15 +26,17 @@ enum class SceneFamily {
     RolledBoth,   ///< Both layers rolled together: on top the inner one lies over the outer
                   ///< (both run back there, so the sides along their travel stay as below).
     ShirtRoll,    ///< A closed body under a shirt rolled over the end of a jacket.
+    CollarWrap,   ///< A closed body under a collar folded around a closed cord at its end: the
+                  ///< cord, under the collar, lies on the collar's outside face all along.
 };
 
 /// All families, in the order above.
 std::vector<SceneFamily> all_scene_families();
 /// "stack", "loops", "folded", "rolled", "jacket", "legs", "rolled_twice", "rolled_both",
-/// "shirt_roll".
+/// "shirt_roll", "collar_wrap".
 std::string family_name(SceneFamily family);
 /// The family has a part lying on the other side of an open layer than the global order
-/// says (Rolled, RolledTwice, ShirtRoll): its nesting holds against its own sides
+/// says (Rolled, RolledTwice, ShirtRoll, CollarWrap): its nesting holds against its own sides
 /// (record_input_sides()), not against the global order. Not RolledBoth: rolled together,
 /// each layer's side of the other, taken along its direction of travel, stays the same.
 bool is_rolled(SceneFamily family);
@@ -46,6 +48,13 @@ struct FamilyParams {
     /// Gap between neighbouring layers in segment lengths (> 0); every layer's thickness is
     /// half the gap, so the required separation is half the gap.
     double gap = 2.0;
+    /// The rolled families' counterpart that keeps the global order, with the same layers and
+    /// about the same vertex counts (the "same scene unrolled", for timings): Rolled and
+    /// RolledTwice turn their roll away from the other layer (the inner layer mirrored across
+    /// its base), ShirtRoll's jacket ends before the shirt's roll (shifted back by one radian),
+    /// CollarWrap's cord lies outside the collar's turned-back part instead of inside the
+    /// fold. No effect on the other families.
+    bool unrolled = false;
     double scale = 1.0;  ///< Every coordinate multiplied by this (> 0) ...
     Vec2 offset{0.0};    ///< ... then shifted by this.
 };
