@@ -107,11 +107,15 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
         scene.metadata = input.metadata;
         for (const Scene::RaisedSeparation& r : input.raised_separations())
             scene.raise_required_separation(r.a, r.b, r.value);
-        const InputSides renumbered = sides.renumbered(origins);
+        // The Scene drops a point equal to its neighbour: then the origins no longer match.
+        bool matched = true;
+        for (std::size_t l = 0; l < layers; ++l)
+            matched = matched && scene.layer(l).points.size() == origins[l].size();
+        const InputSides renumbered = matched ? sides.renumbered(origins) : InputSides{};
         params.input_sides = &renumbered;
         ++checks;
-        CheckReport check = check_scene(scene, params);
-        if (!passes(check)) {
+        CheckReport check = matched ? check_scene(scene, params) : CheckReport{};
+        if (!matched || !passes(check)) {
             for (std::size_t i : taken) kept[candidates[i].layer][candidates[i].index] = 1;
             return false;
         }
