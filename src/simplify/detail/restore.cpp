@@ -45,14 +45,16 @@ bool within(const std::vector<Vec2>& sorted, const Vec2& p, double r) {
 
 // A vertex put back that thin() may take out again.
 struct Restorable {
+    bool kept_before;          // not one the radius put back: tried after those
     double cost;               // twice the area of its triangle (Visvalingam)
     std::size_t layer, index;  // index: in the restored scene's layer
 };
 
-// Takes out again the vertices of `result` that came back from removal (`came_back`, per layer
-// and vertex of result.scene), cheapest first, as long as their layer is above its target
-// (`targets`) and the exact check still passes: a group at once, halved where it fails (few
-// checks when most may go). At most `max_checks` checks.
+// Takes vertices out of the layers of `result` above their target (`targets`) as long as the
+// exact check still passes: first those that came back from removal (`came_back`, per layer and
+// vertex of result.scene), then the others (which the local checks may have kept for want of a
+// view of the whole), each cheapest first; a group at once, halved where it fails (few checks
+// when most may go). At most `max_checks` checks.
 void thin(const Scene& input, Restored& result, const std::vector<std::vector<char>>& came_back,
           const std::vector<std::size_t>& targets, CheckParams params, const InputSides& sides,
           std::size_t max_checks) {
@@ -67,16 +69,17 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
         const std::size_t floor = std::max(targets[l], layer.closed ? std::size_t{3} : 2);
         spare[l] = n > floor ? n - floor : 0;
         for (std::size_t k = 0; k < n && spare[l] > 0; ++k) {
-            if (!came_back[l][k] || (!layer.closed && (k == 0 || k + 1 == n))) continue;
+            if (!layer.closed && (k == 0 || k + 1 == n)) continue;
             const Vec2& a = layer.points[k == 0 ? n - 1 : k - 1];
             const Vec2& b = layer.points[k];
             const Vec2& c = layer.points[k + 1 == n ? 0 : k + 1];
             const double area2 = std::abs((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
-            candidates.push_back({area2, l, k});
+            candidates.push_back({!came_back[l][k], area2, l, k});
         }
     }
     std::sort(candidates.begin(), candidates.end(), [](const Restorable& a, const Restorable& b) {
-        return std::tie(a.cost, a.layer, a.index) < std::tie(b.cost, b.layer, b.index);
+        return std::tie(a.kept_before, a.cost, a.layer, a.index) <
+               std::tie(b.kept_before, b.cost, b.layer, b.index);
     });
     std::vector<std::vector<char>> kept(layers);  // per vertex of `base`: still there
     for (std::size_t l = 0; l < layers; ++l) kept[l].assign(base.layer(l).points.size(), 1);
@@ -119,8 +122,10 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
             for (std::size_t i : taken) kept[candidates[i].layer][candidates[i].index] = 1;
             return false;
         }
-        for (std::size_t i : taken) --spare[candidates[i].layer];
-        result.restored -= taken.size();
+        for (std::size_t i : taken) {
+            --spare[candidates[i].layer];
+            if (!candidates[i].kept_before) --result.restored;
+        }
         result.scene = std::move(scene);
         result.origins = std::move(origins);
         result.check = std::move(check);

@@ -5,9 +5,10 @@
 /// around it: every input vertex within a radius of a violation is put back at its input
 /// position, and the radius doubles until the result is clean. The whole input is the last
 /// step, so a clean input always gives a clean result (simplify() keeps the result only when
-/// it passes). Then the vertices the radius brought back needlessly go again: those of layers
-/// above their target, cheapest first (Visvalingam), a group at a time, kept out when the
-/// exact check still passes, the group halved where it does not. Private to src/simplify.
+/// it passes). Then the layers above their target lose vertices again where the exact check
+/// still passes: first those the radius brought back, then the others, each cheapest first
+/// (Visvalingam), a group at a time, the group halved where the check fails. Private to
+/// src/simplify.
 
 #include "simplify/detail/live_polylines.h"
 #include "strata/geometry/checks.h"
