@@ -55,7 +55,8 @@ Run add_untangle_command(CLI::App& app) {
     cmd->add_flag("--infer-sides", opt->infer_sides,
                   "Without the original: take the sides of the open layers from the input "
                   "itself, each region of a layer on the side most of its vertices are (a "
-                  "rolled part stays so, a vertex a tangle put across takes its region's)")
+                  "rolled part stays so, a vertex a tangle put across takes its region's), "
+                  "with no fallback to the global order")
         ->excludes("--reference");
     cmd->add_flag("--global-order", opt->global_order,
                   "The global order everywhere, also over a rolled part (which it pushes back)")
