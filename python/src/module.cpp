@@ -442,12 +442,15 @@ PYBIND11_MODULE(_strata, m) {
     m.def("_untangle", [](const Scene& scene, const py::dict& kw, const py::object& progress) {
         PythonProgress python_progress{progress, nullptr};
         UntangleParams u;
+        bool global_order = false;
         for (const auto& item : kw) {
             const std::string key = py::str(item.first);
             const py::handle v = item.second;
             if (v.is_none()) continue;
             if (untangle_option(u, key, v))
                 continue;
+            else if (key == "global_order")
+                global_order = v.cast<bool>();
             else if (key == "max_passes")
                 u.max_passes = v.cast<int>();
             else if (key == "shape_matching") {
@@ -463,7 +466,8 @@ PYBIND11_MODULE(_strata, m) {
         {
             py::gil_scoped_release release;
             try {
-                r = untangle_inferring_sides(out, u, python_progress.callback());
+                r = global_order ? untangle(out, u, python_progress.callback())
+                                 : untangle_inferring_sides(out, u, python_progress.callback());
             } catch (const Cancelled&) {
                 py::gil_scoped_acquire acquire;
                 python_progress.rethrow_if_any();

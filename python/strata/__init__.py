@@ -239,6 +239,7 @@ def untangle(
     max_passes: Optional[int] = None,
     shape_matching: bool = True,
     finish: bool = True,
+    global_order: bool = False,
     progress: Optional[Callable[[str, float], bool]] = None,
 ) -> Tuple[Scene, UntangleReport]:
     """Untangles a scene that already crosses (the global mode of ``strata untangle``, without
@@ -252,7 +253,8 @@ def untangle(
     [0, 1]); ``gradient_steps`` 10; ``tolerance`` 1e-6 (relative to the scene diagonal);
     ``max_rounds`` 1 per pass; ``max_passes`` 64; ``shape_matching`` (default True; False =
     pure projection); ``finish`` (default True; False = no finishing stage, the paper's
-    untangling alone). ``progress``: as in
+    untangling alone); ``global_order`` (default False; True = the global order alone, as
+    ``strata untangle --global-order``). ``progress``: as in
     :func:`simplify`, called once per round ("untangle", fraction)."""
     return _strata._untangle(
         scene,
@@ -266,6 +268,7 @@ def untangle(
             max_passes=max_passes,
             shape_matching=shape_matching,
             finish=finish,
+            global_order=global_order,
         ),
         progress,
     )

@@ -115,6 +115,19 @@ def test_untangle_mends_a_crossing_pair():
     assert strata.check(scene).crossings == before.crossings  # the input is not changed
 
 
+def test_untangle_keeps_a_roll_unless_told_the_global_order():
+    # A shirt rolled over the end of a jacket, tangled by naive random decimation (as the CLI
+    # tests do): by default its rolled regions keep their inferred sides; the global order
+    # alone pushes the roll back and does not come out clean.
+    original = strata.read_scene(DATA / "rolled_shirt_over_jacket.json")
+    tangled, _ = strata.simplify(original, remove=0.95, decimator="random", seed=1, untangle=False)
+    assert strata.check(tangled).crossings > 0
+    _, report = strata.untangle(tangled)
+    assert report.collision_free and report.inferred_sides
+    _, global_report = strata.untangle(tangled, global_order=True)
+    assert not global_report.inferred_sides and not global_report.collision_free
+
+
 def test_check_lists_crossings():
     scene = strata.read_scene(DATA / "crossing_pair.json")
     r = strata.check(scene)
