@@ -7,15 +7,22 @@
 #include "strata/io/scene_io.h"
 
 #include <iostream>
+#include <utility>
 
 namespace strata::cli {
 
 Reference read_reference(const std::string& path, const Scene& scene, double near_distance,
                          bool every_layer, double thickness) {
-    Reference ref;
-    ref.scene = with_default_thickness(read_scene(path), thickness);
-    for (const std::string& note : ref.scene.diagnostics().notes)
+    Scene original = with_default_thickness(read_scene(path), thickness);
+    for (const std::string& note : original.diagnostics().notes)
         std::cerr << "strata: note: " << path << ": " << note << '\n';
+    return match_reference(std::move(original), scene, near_distance, every_layer, path);
+}
+
+Reference match_reference(Scene original, const Scene& scene, double near_distance,
+                          bool every_layer, const std::string& name) {
+    Reference ref;
+    ref.scene = std::move(original);
     std::string missing;
     std::size_t matched = 0, missing_count = 0;
     for (std::size_t i = 0; i < scene.size(); ++i) {
@@ -34,10 +41,10 @@ Reference read_reference(const std::string& path, const Scene& scene, double nea
     }
     if (missing_count > 5) missing += ", ...";
     if (matched == 0 && scene.size() > 0)
-        throw InvalidInput(path + ": the reference has no layer named as one of the scene's (" +
+        throw InvalidInput(name + ": the reference has no layer named as one of the scene's (" +
                            missing + "): layers are matched by name");
     if (every_layer && missing_count > 0)
-        throw InvalidInput(path + ": the reference has no layer named " + missing + " (" +
+        throw InvalidInput(name + ": the reference has no layer named " + missing + " (" +
                            std::to_string(missing_count) + " of " + std::to_string(scene.size()) +
                            " layers): layers are matched by name");
     // ORIG's own sides of its open layers (a rolled part): the scene's vertices take those of

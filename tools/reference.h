@@ -36,4 +36,9 @@ struct Reference {
 Reference read_reference(const std::string& path, const Scene& scene, double near_distance,
                          bool every_layer, double thickness = 0.0);
 
+/// read_reference() on an original already read (`original`, kept in the result); `name`
+/// names it in the errors (its path, or e.g. "reference"). Same throws but IoError.
+Reference match_reference(Scene original, const Scene& scene, double near_distance,
+                          bool every_layer, const std::string& name);
+
 }  // namespace strata::cli

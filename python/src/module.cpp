@@ -6,6 +6,7 @@
 // (ValueError), strata.IoError (OSError) and strata.Cancelled (RuntimeError), with the message
 // the CLI prints after "strata: error: ".
 #include "cli_util.h"
+#include "reference.h"
 #include "simplify_batch.h"
 
 #include "strata/core/error.h"
@@ -489,15 +490,14 @@ PYBIND11_MODULE(_strata, m) {
             std::map<std::string, double> h;
             {
                 py::gil_scoped_release release;
+                std::optional<cli::Reference> ref;
                 if (reference) {
-                    // As `strata check --reference`: open layers take their outside side
-                    // from the reference.
-                    for (std::size_t i = 0; i < scene.size(); ++i) {
-                        const auto j = reference->find(scene.layer(i).name);
-                        params.outside_sides.push_back(
-                            j ? outside_side(*reference, *j, params.near_distance)
-                              : outside_side(scene, i, params.near_distance));
-                    }
+                    // As `strata check --reference`: open layers take their outside side and
+                    // the sides of their vertices (a rolled part) from the reference.
+                    ref = cli::match_reference(*reference, scene, params.near_distance, false,
+                                               "reference");
+                    params.outside_sides = ref->outside_sides;
+                    params.input_sides = &ref->sides;
                     const Box2 b = reference->bounds();
                     const double diagonal = std::hypot(b.max.x - b.min.x, b.max.y - b.min.y);
                     for (std::size_t i = 0; i < scene.size(); ++i)

@@ -308,7 +308,10 @@ def check(
     closer than ``near`` (scene units, 0 = automatic: max(5% of the diagonal, 2 x the largest
     required separation)), nesting; with ``reference``, the symmetric Hausdorff distance of
     each layer to the reference's layer of the same name (to within ``hausdorff_tolerance`` x
-    the reference's diagonal), and open layers take their outside side from the reference.
+    the reference's diagonal), and nesting is judged against the reference's sides as in
+    ``strata check --reference`` (open layers take their outside side from it, and each vertex
+    the side of the nearest vertex of its layer there: a rolled part keeps its side; a
+    reference with none of the scene's layer names raises InvalidInput).
     ``separation_tolerance``: a gap passes when gap >= required x (1 - tol), [0, 1)."""
     d = _strata._check(scene, reference, near, separation_tolerance, hausdorff_tolerance)
     return CheckReport(**d)
