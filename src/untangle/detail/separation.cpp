@@ -28,10 +28,10 @@ struct SegId {
 // Gauss-Seidel sweep, so the order of query() matters (sorting the segments by (layer, index)
 // instead changes the outputs and breaks the rolled cases of the tests). This order (cells row
 // by row, clamped to the region; within a cell, filing order) is not UniformGrid's (columns
-// first): the UniformGrid version (commit e92f89e, branch cells-grid) sorts each query's
-// segments by this key, gives byte-identical outputs, and makes strata simplify 8x10k
-// --remove 0.98 --threads 1 3-5% slower (cpu median ratio 1.028 and 1.045; main against
-// itself 0.995).
+// first): a UniformGrid version that sorted each query's segments by this key gave
+// byte-identical outputs and made strata simplify 8x10k --remove 0.98 --threads 1 3-5% slower
+// (cpu median ratio 1.028 and 1.045, main against itself 0.995; tried in the tenth session,
+// not kept).
 class SegmentCells {
   public:
     // Files the segments whose box meets `region` (queries must stay inside it).
