@@ -170,18 +170,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         u.max_rounds = static_cast<int>(in.range(1, 4));
         u.gradient_steps = static_cast<int>(in.range(1, 10));
         u.finish_separations = in.byte() % 4 != 0;
+        const strata::Scene tangled = scene;
         strata::UntangleReport ur;
         try {
-            ur = strata::untangle(scene, u);
+            ur = strata::untangle_inferring_sides(scene, u);  // as the CLI
         } catch (const strata::InvalidInput& e) {
             return known_refusal(e);
         }
-        if (ur.collision_free) {
-            const strata::CheckReport after =
-                exact_check(scene, input_sides, u.separation_tolerance);
-            FUZZ_CHECK(clean(after), "untangle called a tangled output clean");
-        }
-        if (!strata::check_scene(scene).is_collision_free()) return 0;  // refused, as the CLI does
+        // Judged as it judged itself: the global order, or the sides inferred per region of
+        // the tangled scene where it kept those.
+        const strata::InputSides inferred =
+            ur.inferred_sides ? strata::infer_input_sides(tangled) : strata::InputSides{};
+        const strata::CheckReport after =
+            ur.inferred_sides ? exact_check(scene, strata::outside_sides(tangled),
+                                            u.separation_tolerance, &inferred)
+                              : exact_check(scene, input_sides, u.separation_tolerance);
+        if (ur.collision_free) FUZZ_CHECK(clean(after), "untangle called a tangled output clean");
+        if (!after.is_collision_free()) return 0;  // refused, as the CLI does
     }
 
     const strata::Scene input = scene;
