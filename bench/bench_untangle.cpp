@@ -186,20 +186,19 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
     const double start = now();
     Row row;
     UntangleReport report;
+    InputSides inferred;  // the sides it kept, when inferred
     try {
         const ProgressFn capped = [&](std::string_view, double) {
             return now() - start < cap_seconds;
         };
         report = keep_sides || global_order ? untangle(scene, p, capped)
-                                            : untangle_inferring_sides(scene, p, capped);
+                                            : untangle_inferring_sides(scene, p, capped, &inferred);
     } catch (const Cancelled&) {
         row.capped = true;
         scene = tangled;
     }
     const double seconds = now() - start;
-    InputSides inferred;
     if (how == "real" && report.inferred_sides) {  // judged as untangle judged it
-        inferred = infer_input_sides(tangled);
         scoring.outside_sides = outside_sides(tangled);
         scoring.input_sides = &inferred;
     }

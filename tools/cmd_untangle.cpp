@@ -116,13 +116,12 @@ Run add_untangle_command(CLI::App& app) {
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();
         const bool fallback = !params.input_sides && !opt->global_order;
-        const UntangleReport r = fallback
-                                     ? untangle_inferring_sides(scene, params, terminal_progress())
-                                     : untangle(scene, params, terminal_progress());
+        const UntangleReport r =
+            fallback ? untangle_inferring_sides(scene, params, terminal_progress(), &inferred)
+                     : untangle(scene, params, terminal_progress());
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (r.inferred_sides) {  // the input's rolled regions were kept
-            inferred = infer_input_sides(input);
+        if (r.inferred_sides) {  // the input's rolled regions were kept, `inferred` holds them
             params.input_sides = &inferred;
             check_params.input_sides = &inferred;
         }

@@ -140,11 +140,10 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
 Scene untangle_input(const Scene& start, const UntangleParams& u, InputUntangling& info,
                      CheckReport& after) {
     Scene scene = start;
-    info.report = untangle_inferring_sides(scene, u);
-    CheckParams check_params;
     InputSides inferred;
+    info.report = untangle_inferring_sides(scene, u, {}, &inferred);
+    CheckParams check_params;
     if (info.report.inferred_sides) {
-        inferred = infer_input_sides(start);
         check_params.outside_sides = outside_sides(start);
         check_params.input_sides = &inferred;  // untangling keeps the vertex indices
     }

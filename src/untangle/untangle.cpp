@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace strata {
 
@@ -154,12 +155,12 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
 }
 
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
-                                        const ProgressFn& progress) {
+                                        const ProgressFn& progress, InputSides* kept) {
     if (params.input_sides && !params.input_sides->empty())
         return untangle(scene, params, progress);
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
-    const InputSides inferred = infer_input_sides(scene);
+    InputSides inferred = infer_input_sides(scene);
     UntangleParams with_sides = params;
     with_sides.outside_sides =
         params.outside_sides.empty() ? outside_sides(scene) : params.outside_sides;
@@ -170,6 +171,7 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         if (report.collision_free) {
             report.inferred_sides = true;
             scene = std::move(rolled);
+            if (kept) *kept = std::move(inferred);
             return report;
         }
     }

@@ -147,9 +147,12 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// rolled; that result is kept when it is clean against those sides (report.inferred_sides).
 /// Otherwise, or when it is not clean, by the global order (untangle() from the input). With
 /// params.input_sides given, this is untangle(). Same params, progress and throws as
-/// untangle().
+/// untangle(). `kept`: if given, receives the inferred sides when they were kept, for judging
+/// the result (check_scene() with them and params' outside sides, or outside_sides() of the
+/// input); left alone otherwise.
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params = {},
-                                        const ProgressFn& progress = {});
+                                        const ProgressFn& progress = {},
+                                        InputSides* kept = nullptr);
 
 /// @brief Untangles only the vertices of `scene` inside `box`, with collars of `n_out` fixed
 /// vertices (localize()). The fields are built for whole layers here; the simplification
