@@ -33,6 +33,34 @@ double rolled_gap(const FamilyParams& p) {
     return p.gap * 10.0 / static_cast<double>(p.points - 1);
 }
 
+// simplify() of a rolled input, and the exact check of its output against the input's sides.
+struct Simplified {
+    Scene out;
+    SimplifyReport report;
+    CheckReport check;
+};
+
+// simplify() of `input` with these settings: reported collision-free, and checked here again,
+// independently of simplify()'s own check, against the input's sides (`sides`,
+// record_input_sides(input); `outside`, outside_sides(input)): no crossing, the sides kept,
+// gaps >= 0.9 x required.
+Simplified simplify_keeping_sides(const Scene& input, const std::vector<int>& outside,
+                                  const InputSides& sides, const char* decimator, double remove,
+                                  UntangleSchedule schedule) {
+    SimplifyParams params;
+    params.decimator = decimator;
+    params.remove = remove;
+    params.schedule = schedule;
+    Simplified r{input, {}, {}};
+    r.report = simplify(r.out, params);
+    CHECK(r.report.collision_free);
+    const InputSides out_sides = sides.renumbered(r.report.origins);
+    r.check =
+        test::check_with_sides(r.out, outside, params.untangling.separation_tolerance, &out_sides);
+    test::require_sides_kept(r.check, 0.9);
+    return r;
+}
+
 }  // namespace
 
 TEST_CASE("the input's sides record the roll; a vertex that changes side is flagged", "[rolled]") {
@@ -91,13 +119,10 @@ TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolle
                     INFO("gap " << gap << " " << decimator << " remove " << remove
                                 << (schedule == UntangleSchedule::Deferred ? " deferred"
                                                                            : " immediate"));
-                    SimplifyParams params;
-                    params.decimator = decimator;
-                    params.remove = remove;
-                    params.schedule = schedule;
-                    Scene out = input;
-                    const SimplifyReport report = simplify(out, params);
-                    CHECK(report.collision_free);
+                    const Simplified s =
+                        simplify_keeping_sides(input, outside, sides, decimator, remove, schedule);
+                    const Scene& out = s.out;
+                    const SimplifyReport& report = s.report;
                     // The rolled layer meets its budget. (The outer one is a straight line:
                     // its collinear removals are refused the same way without the roll, a
                     // weakness of the driver's local test, not of the sides.)
@@ -109,13 +134,7 @@ TEST_CASE("simplify keeps a roll: clean, gaps, sides, budget and shape", "[rolle
                                              schedule == UntangleSchedule::Deferred;
                     if (shape_asked) CHECK(report.layers[0].after <= report.layers[0].target);
                     CHECK(report.rolled_vertices > 0);
-
-                    // Checked here again, independently of simplify()'s own check.
-                    const InputSides out_sides = sides.renumbered(report.origins);
-                    const CheckReport check = test::check_with_sides(
-                        out, outside, params.untangling.separation_tolerance, &out_sides);
-                    test::require_sides_kept(check, 0.9);
-                    CHECK(check.separation_violation_count == 0);
+                    CHECK(s.check.separation_violation_count == 0);
                     // The shape: within 2 gaps of the input. Not asked of the random
                     // decimator, which may remove the whole bend of the roll and leave the
                     // untangling to pull the layer around the end of the other one (measured:
@@ -141,20 +160,10 @@ namespace {
 // required, every layer on target, Hausdorff <= 2 x `gap`.
 void check_kept(const Scene& input, double gap, const char* decimator, double remove,
                 UntangleSchedule schedule) {
-    const std::vector<int> outside = outside_sides(input);
-    const InputSides sides = record_input_sides(input);
-    SimplifyParams params;
-    params.decimator = decimator;
-    params.remove = remove;
-    params.schedule = schedule;
-    Scene out = input;
-    const SimplifyReport report = simplify(out, params);
-    CHECK(report.collision_free);
-    CHECK(report.targets_met);
-    const InputSides out_sides = sides.renumbered(report.origins);
-    test::require_sides_kept(
-        test::check_with_sides(out, outside, params.untangling.separation_tolerance, &out_sides),
-        0.9);
+    const Simplified s = simplify_keeping_sides(
+        input, outside_sides(input), record_input_sides(input), decimator, remove, schedule);
+    const Scene& out = s.out;
+    CHECK(s.report.targets_met);
     for (std::size_t l = 0; l < out.size(); ++l)
         CHECK(hausdorff(out.layer(l), input.layer(l), 1e-6 * gap).symmetric() <= 2.0 * gap);
 }
@@ -253,19 +262,10 @@ TEST_CASE("a collar folded around a closed cord keeps the cord in the fold", "[r
                     }
                     // The random decimator: clean with the input's sides kept (its shape and
                     // budget are not asked, as for the other rolled families above).
-                    SimplifyParams params;
-                    params.decimator = decimator;
-                    params.remove = remove;
-                    params.schedule = schedule;
-                    Scene out = input;
-                    const SimplifyReport report = simplify(out, params);
-                    CHECK(report.collision_free);
-                    CHECK(report.rolled_vertices > 0);
-                    const InputSides out_sides = sides.renumbered(report.origins);
-                    test::require_sides_kept(
-                        test::check_with_sides(out, outside, params.untangling.separation_tolerance,
-                                               &out_sides),
-                        0.9);
+                    const Simplified s =
+                        simplify_keeping_sides(input, outside, sides, decimator, remove, schedule);
+                    const Scene& out = s.out;
+                    CHECK(s.report.rolled_vertices > 0);
                     // The cord stays in the fold: off the body, between the collar's two parts.
                     for (const Vec2& p : out.layer(cord).points) {
                         const double r = std::hypot(p.x, p.y);

@@ -119,6 +119,19 @@ std::pair<std::size_t, std::size_t> still_on_top(const RolledCase& c, const Scen
     return {judged, on_top};
 }
 
+// `out`, untangled from `tangled` (case c's input decimated), kept the roll: clean against the
+// original's sides (`sides`, matched onto `tangled`) with gaps >= 0.9 x required, and what lay
+// on top of the other layer still does.
+void require_roll_kept(const RolledCase& c, const Scene& tangled, const Scene& out,
+                       const InputSides& sides) {
+    test::require_sides_kept(test::check_with_sides(out, outside_sides(c.input),
+                                                    UntangleParams{}.separation_tolerance, &sides),
+                             0.9);
+    const auto [judged, on_top] = still_on_top(c, tangled, out);
+    CHECK(judged > 0);
+    CHECK(on_top == judged);
+}
+
 Scene naive_decimation(const Scene& input, double remove, unsigned seed,
                        std::vector<std::vector<std::size_t>>* origins = nullptr) {
     SimplifyParams naive;
@@ -181,13 +194,8 @@ TEST_CASE("untangle keeps a roll with the original's sides (naive decimation at 
                 CHECK(report.rolled_vertices > 0);
                 CHECK(report.rolled_kept == report.rolled_vertices);
 
-                // Checked again here against the original's sides.
-                test::require_sides_kept(
-                    test::check_with_sides(out, outside, params.separation_tolerance, &sides), 0.9);
-                // The roll is kept: what lay on top of the other layer still does.
-                const auto [judged, on_top] = still_on_top(c, tangled, out);
-                CHECK(judged > 0);
-                CHECK(on_top == judged);
+                // Checked again here against the original's sides; the roll is kept.
+                require_roll_kept(c, tangled, out, sides);
                 // And the shape: the untangling adds little to what the decimation took away.
                 // At 95% one case moved more (shirt, gap 2, seed 2: +7.9 gaps; a chord of the
                 // shirt across the jacket's end, pulled back along it).
@@ -310,11 +318,7 @@ TEST_CASE("untangle with sides inferred per region keeps a roll (no original at 
                     ++cut;
                     continue;
                 }
-                test::require_sides_kept(
-                    test::check_with_sides(out, outside, params.separation_tolerance, &sides), 0.9);
-                const auto [judged, on_top] = still_on_top(c, tangled, out);
-                CHECK(judged > 0);
-                CHECK(on_top == judged);
+                require_roll_kept(c, tangled, out, sides);
                 const double tol = 1e-6 * c.gap;
                 CHECK(hausdorff_to(out, c.input, tol) <=
                       hausdorff_to(tangled, c.input, tol) + (remove < 0.92 ? 2.0 : 10.0) * c.gap);
@@ -346,11 +350,7 @@ TEST_CASE("untangle_inferring_sides: the inferred sides where the input has roll
         // Against the original's sides: the roll kept.
         const InputSides sides = InputSides::matched(record_input_sides(c.input), c.input, tangled);
         if (bend_cut(tangled, sides)) continue;
-        test::require_sides_kept(test::check_with_sides(out, outside_sides(c.input),
-                                                        params.separation_tolerance, &sides),
-                                 0.9);
-        const auto [judged, on_top] = still_on_top(c, tangled, out);
-        CHECK(on_top == judged);
+        require_roll_kept(c, tangled, out, sides);
     }
     // No rolled region: untangle()'s result.
     const Scene stack = make_scene(SceneFamily::Stack);
