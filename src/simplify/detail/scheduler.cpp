@@ -270,6 +270,14 @@ bool Scheduler::waits_on(std::size_t l) const {
     return false;
 }
 
+// The candidates set aside while the batch waited (postponed and held) go back to the queue.
+void Scheduler::requeue_set_aside() {
+    for (const Candidate& c : postponed_) queue_.push(c);
+    postponed_.clear();
+    for (const Candidate& c : held_) queue_.push(c);
+    held_.clear();
+}
+
 // Sets candidate c aside until the batch has run; runs it when too many wait.
 void Scheduler::postpone(const Candidate& c) {
     postponed_.push_back(c);
@@ -281,10 +289,7 @@ void Scheduler::postpone(const Candidate& c) {
 // it waited) is run again alone afterwards, so the outcome is the same at any thread count.
 void Scheduler::flush() {
     if (pending_.empty()) {
-        for (const Candidate& c : postponed_) queue_.push(c);
-        postponed_.clear();
-        for (const Candidate& c : held_) queue_.push(c);
-        held_.clear();
+        requeue_set_aside();
         return;
     }
     ++report_.batches;
@@ -313,10 +318,7 @@ void Scheduler::flush() {
         conclude(jobs[i].l, jobs[i].v, commit(jobs[i]));
     }
     touched_.clear();
-    for (const Candidate& c : postponed_) queue_.push(c);
-    postponed_.clear();
-    for (const Candidate& c : held_) queue_.push(c);
-    held_.clear();
+    requeue_set_aside();
     for (std::size_t i : again) {
         const Job& job = jobs[i];
         report_.seconds_fields += job.result.seconds_fields;  // the first run's time

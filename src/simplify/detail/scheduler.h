@@ -62,6 +62,7 @@ class Scheduler {
     void remove_batched(const Candidate& c);
     bool waits_on(std::size_t l) const;
     void postpone(const Candidate& c);
+    void requeue_set_aside();
     void flush();
     bool batching() const { return params_.untangle && !defer_ && !params_.global; }
 
