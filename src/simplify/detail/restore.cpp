@@ -43,6 +43,15 @@ bool within(const std::vector<Vec2>& sorted, const Vec2& p, double r) {
     return false;
 }
 
+// A scene of `layers` with the units, metadata and raised separations of `input`.
+Scene like_input(const Scene& input, std::vector<Layer> layers) {
+    Scene scene(std::move(layers), input.units());
+    scene.metadata = input.metadata;
+    for (const Scene::RaisedSeparation& r : input.raised_separations())
+        scene.raise_required_separation(r.a, r.b, r.value);
+    return scene;
+}
+
 // A vertex put back that thin() may take out again.
 struct Restorable {
     bool kept_before;          // not one the radius put back: tried after those
@@ -106,10 +115,7 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
                     origins[l].push_back(base_origins[l][k]);
                 }
         }
-        Scene scene(std::move(thinned), input.units());
-        scene.metadata = input.metadata;
-        for (const Scene::RaisedSeparation& r : input.raised_separations())
-            scene.raise_required_separation(r.a, r.b, r.value);
+        Scene scene = like_input(input, std::move(thinned));
         // The Scene drops a point equal to its neighbour: then the origins no longer match.
         bool matched = true;
         for (std::size_t l = 0; l < layers; ++l)
@@ -178,17 +184,14 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
             }
             layers[l].points = std::move(kept);
         }
-        Scene scene(std::move(layers), input.units());
-        scene.metadata = input.metadata;
-        for (const Scene::RaisedSeparation& r : input.raised_separations())
-            scene.raise_required_separation(r.a, r.b, r.value);
+        Scene scene = like_input(input, std::move(layers));
         const InputSides renumbered = sides.renumbered(result.origins);
         params.input_sides = &renumbered;
         result.check = check_scene(scene, params);
         result.scene = std::move(scene);
         if (passes(result.check)) {
-            // Then what the radius put back needlessly goes again, within a budget of
-            // checks (each reads the whole scene).
+            // Then the layers above their target lose vertices again where the check allows,
+            // within a budget of checks (each reads the whole scene).
             std::vector<std::size_t> targets(input.size());
             for (std::size_t l = 0; l < input.size(); ++l) targets[l] = live.layer(l).target;
             const std::size_t checks = std::max<std::size_t>(
