@@ -6,7 +6,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 using namespace strata;
 using Catch::Matchers::Contains;
@@ -159,4 +163,76 @@ TEST_CASE("writing is atomic and never overwrites an input", "[io][json]") {
     CHECK_THROWS_WITH(read_scene_json(dir / "absent.json"),
                       Contains("absent.json") && Contains("cannot open"));
     fs::remove_all(dir);
+}
+
+TEST_CASE("the direct reader reads numbers and fields as the SAX reader does", "[io][json]") {
+    // An unknown root key sends a text to the SAX reader; without it, the direct reader reads
+    // it. Both must give the same bits (signs of zeros, integers beyond 2^53, long mantissas).
+    const std::vector<std::string> numbers = {"0",
+                                              "-0",
+                                              "-0.0",
+                                              "1",
+                                              "-1",
+                                              "0.1",
+                                              "1e5",
+                                              "1E-3",
+                                              "-2.5e+2",
+                                              "12345678901234567890",
+                                              "123456789012345678901234",
+                                              "-9223372036854775809",
+                                              "9007199254740993",
+                                              "1e308",
+                                              "2.2250738585072014e-308",
+                                              "0.30000000000000004",
+                                              "3.141592653589793238462643383279"};
+    auto text = [](const std::string& x, const std::string& y, bool unknown) {
+        return std::string("{\"strata\": 1, \"units\": \"mm\",") + (unknown ? "\"x\": 1," : "") +
+               "\"layers\": [{\"name\": \"a\", \"closed\": false, \"thickness\": 1e-3" +
+               ", \"weight\": 2, \"alpha\": null, \"beta\": 0.5, \"outer\": [],\n\"points\": [[" +
+               x + ", " + y + "], [" + y + "," + x +
+               "]]}, {\"points\": [[1, 2], [3, 2], [3, 5]], \"closed\": " +
+               "true, \"outer\": [\"a\"]}]}";
+    };
+    auto bits = [](double v) {
+        std::uint64_t b = 0;
+        std::memcpy(&b, &v, sizeof b);
+        return b;
+    };
+    for (const std::string& x : numbers)
+        for (const std::string& y : {std::string("7"), std::string("-1e-5")}) {
+            INFO(x << " " << y);
+            const Scene direct = parse_scene_json(text(x, y, false), "direct.json");
+            const Scene sax = parse_scene_json(text(x, y, true), "sax.json");
+            REQUIRE(direct.metadata.empty());
+            REQUIRE(sax.metadata.size() == 1);
+            REQUIRE(direct.size() == sax.size());
+            REQUIRE(direct.units() == sax.units());
+            for (std::size_t i = 0; i < direct.size(); ++i) {
+                const Layer& a = direct.layer(i);
+                const Layer& b = sax.layer(i);
+                REQUIRE(a.name == b.name);
+                REQUIRE(a.closed == b.closed);
+                REQUIRE(bits(a.thickness) == bits(b.thickness));
+                REQUIRE(bits(a.weight) == bits(b.weight));
+                REQUIRE(a.alpha == b.alpha);
+                REQUIRE(a.beta == b.beta);
+                REQUIRE(a.outer == b.outer);
+                REQUIRE(a.points.size() == b.points.size());
+                for (std::size_t k = 0; k < a.points.size(); ++k) {
+                    REQUIRE(bits(a.points[k].x) == bits(b.points[k].x));
+                    REQUIRE(bits(a.points[k].y) == bits(b.points[k].y));
+                }
+            }
+        }
+    // What the direct reader gives up on still reads (or fails) as before.
+    for (const char* odd :
+         {R"({"layers": [{"points": [[1, 2], [3, 4]], "name": "a\u00e9"}]})",
+          R"({"layers": [{"points": [[1, 2], [3, 4]], "name": "é"}]})",
+          R"({"layers": [{"points": [[1, 2], [3, 4]], "points": [[3, 4], [5, 6]]}]})"})
+        REQUIRE_NOTHROW(parse_scene_json(odd, "odd.json"));
+    for (const char* bad : {R"({"layers": [{"points": [[01, 2], [3, 4]]}]})",
+                            R"({"layers": [{"points": [[1., 2], [3, 4]]}]})",
+                            R"({"layers": [{"points": [[1, 2], [3, 4]]}]} x)",
+                            R"({"strata": 1.0, "layers": [{"points": [[1, 2], [3, 4]]}]})"})
+        REQUIRE_THROWS_AS(parse_scene_json(bad, "bad.json"), InvalidInput);
 }
