@@ -73,14 +73,26 @@ class SegmentIndex {
         if (segments_.empty() && count > 0) add(0);
         Box2 bounds;
         std::vector<double> lengths;
-        std::vector<std::uint32_t> ids;
         for (std::size_t s : segments_) {
             bounds.extend(box(s));
-            lengths.push_back(std::hypot(end(s).x - start(s).x, end(s).y - start(s).y));
-            ids.push_back(static_cast<std::uint32_t>(s));
+            const Vec2 d = end(s) - start(s);
+            lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));  // sizes the cells only
         }
-        grid_ = segment_grid(bounds, median_of(lengths), segments_.size());
-        grid_.build(ids, [&](std::uint32_t s) { return box(s); });
+        const double median = median_of(lengths);
+        // The chunks of kChunk consecutive kept segments: what the grid files.
+        std::vector<std::uint32_t> ids;
+        for (std::size_t q = 0; q < segments_.size(); q += kChunk) {
+            Box2 b;
+            for (std::size_t r = q; r < std::min(q + kChunk, segments_.size()); ++r)
+                b.extend(box(segments_[r]));
+            ids.push_back(static_cast<std::uint32_t>(chunk_boxes_.size()));
+            chunk_boxes_.push_back(b);
+        }
+        for (const Vec2& v : layer.points)
+            magnitude_ = std::max({magnitude_, std::abs(v.x), std::abs(v.y)});
+        chunk_length_ = static_cast<double>(kChunk) * median;
+        chunk_grid_ = segment_grid(bounds, median, segments_.size());
+        chunk_grid_.build(ids, [&](std::uint32_t c) { return chunk_boxes_[c]; });
     }
 
     const Layer& layer() const { return *layer_; }
@@ -120,32 +132,138 @@ class SegmentIndex {
         bool found() const { return segment != kNone; }
     };
 
+    /// What nearest() keeps from one query to the next along a polyline: the last nearest
+    /// segment (where the next search starts) and the chunks within `radius` of `center`.
+    struct Cursor {
+        std::size_t hint = kNone;
+        Vec2 center{0.0};
+        double radius = -1.0;  // none gathered yet
+        std::vector<std::uint32_t> chunks;
+    };
+
     /// The closest point of the layer to `p` if closer than `cutoff` (the segment of smallest
-    /// index among equally close ones).
-    Nearest nearest(const Vec2& p, double cutoff) const {
+    /// index among equally close ones). With a cursor (the previous vertex's query), the
+    /// search starts from its segment: it and the kept segments after and before it while
+    /// they get nearer bound the distance d, and only the chunks the cursor gathered are read
+    /// when they hold every segment within d of p (else it gathers them again around p). The
+    /// result does not depend on the cursor.
+    Nearest nearest(const Vec2& p, double cutoff, Cursor* cursor = nullptr) const {
+        const std::size_t hint = cursor ? cursor->hint : kNone;
         Nearest best;
-        grid_.nearest(p, cutoff, [&](std::uint32_t id) {
-            const std::size_t s = id;
+        double best2 = kInf;
+        // A segment or chunk is measured only when it may be as near as the best: what is
+        // set aside is farther than `guard`, the best plus a slack far above the rounding of
+        // the distances (ties are all measured, so the tie-break sees them).
+        const double slack = 1e-9 * (std::abs(p.x) + std::abs(p.y) + magnitude_);
+        double guard2 = kInf;
+        // Farther than the guard, told without a division or a square root: the distance to
+        // the end nearer along the segment, or to its line.
+        auto far = [&](const Vec2& a, const Vec2& b) {
+            const double dx = b.x - a.x, dy = b.y - a.y;
+            const double wx = p.x - a.x, wy = p.y - a.y;
+            const double dot = wx * dx + wy * dy, len2 = dx * dx + dy * dy;
+            if (dot <= 0.0) return wx * wx + wy * wy > guard2;
+            if (dot >= len2) {
+                const double ex = p.x - b.x, ey = p.y - b.y;
+                return ex * ex + ey * ey > guard2;
+            }
+            const double cross = wx * dy - wy * dx;
+            return cross * cross > guard2 * len2;
+        };
+        auto offer = [&](std::size_t s) {
             const Vec2 a = start(s), b = end(s);
+            if (far(a, b)) return;
             Vec2 closest;
             const double d = point_segment_distance(p, a, b, &closest);
             if (d < best.distance || (d == best.distance && s < best.segment)) {
                 best.distance = d;
                 best.segment = s;
                 best.point = closest;
+                best2 = d * d;
+                const double guard = d + 1e-9 * d + slack;
+                guard2 = guard * guard;
             }
-            return best.distance * best.distance;
-        });
-        if (!(best.distance < cutoff)) return Nearest{};
+        };
+        const std::size_t count = segments_.size();
+        std::size_t lo = 1, hi = 0;  // positions the walk offered: [lo, hi]
+        if (hint != kNone) {
+            lo = hi = position_[hint];
+            offer(hint);
+            while (hi + 1 < count) {
+                const std::size_t s = segments_[++hi];
+                offer(s);
+                if (best.segment != s) break;
+            }
+            while (lo > 0) {
+                const std::size_t s = segments_[--lo];
+                offer(s);
+                if (best.segment != s) break;
+            }
+            if (!(best.distance < cutoff)) {
+                best = Nearest{};
+                best2 = kInf;
+                lo = 1;
+                hi = 0;
+            }
+        }
+        auto beyond = [&](const Box2& b) {
+            const double dx = std::max({b.min.x - p.x, 0.0, p.x - b.max.x});
+            const double dy = std::max({b.min.y - p.y, 0.0, p.y - b.max.y});
+            return dx * dx + dy * dy > guard2;
+        };
+        auto offer_chunk = [&](std::uint32_t c) {
+            if (beyond(chunk_boxes_[c])) return best2;
+            const std::size_t q0 = std::size_t{c} * kChunk;
+            const std::size_t q1 = std::min(q0 + kChunk, count);
+            for (std::size_t q = q0; q < q1; ++q) {
+                if (lo <= q && q <= hi) continue;  // offered by the walk
+                offer(segments_[q]);
+            }
+            return best2;
+        };
+        if (best.found() && cursor) {
+            const Vec2 m = p - cursor->center;
+            const double moved = std::sqrt(m.x * m.x + m.y * m.y);
+            if (!(moved + best.distance + slack <= cursor->radius)) {
+                // Gathered with room for the next vertices: twice the distance and a chunk.
+                cursor->center = p;
+                cursor->radius = 2.0 * best.distance + chunk_length_;
+                cursor->chunks.clear();
+                Box2 square;
+                const double r = cursor->radius + slack;
+                square.extend(p - Vec2(r));
+                square.extend(p + Vec2(r));
+                chunk_grid_.query_once(
+                    square, [&](std::uint32_t c) { return chunk_boxes_[c]; },
+                    [&](std::uint32_t c) {
+                        const Box2& b = chunk_boxes_[c];
+                        const double dx = std::max({b.min.x - p.x, 0.0, p.x - b.max.x});
+                        const double dy = std::max({b.min.y - p.y, 0.0, p.y - b.max.y});
+                        if (dx * dx + dy * dy <= r * r) cursor->chunks.push_back(c);
+                    });
+            }
+            for (const std::uint32_t c : cursor->chunks) offer_chunk(c);
+        } else if (best.found()) {
+            chunk_grid_.nearest_within(p, best.distance, offer_chunk);
+        } else {
+            chunk_grid_.nearest(p, cutoff, offer_chunk);
+        }
+        if (!(best.distance < cutoff)) best = Nearest{};
+        if (cursor) cursor->hint = best.segment;
         return best;
     }
 
-    /// Calls f(s) once per kept segment s whose box meets `b`.
+    /// Calls f(s) once per kept segment s whose box meets `b` (in no particular order).
     template <class F>
     void segments_meeting(const Box2& b, F&& f) const {
-        grid_.query_once(
-            b, [&](std::uint32_t s) { return box(s); },
-            [&](std::uint32_t s) { f(static_cast<std::size_t>(s)); });
+        chunk_grid_.query_once(
+            b, [&](std::uint32_t c) { return chunk_boxes_[c]; },
+            [&](std::uint32_t c) {
+                const std::size_t q0 = std::size_t{c} * kChunk;
+                const std::size_t q1 = std::min(q0 + kChunk, segments_.size());
+                for (std::size_t q = q0; q < q1; ++q)
+                    if (box(segments_[q]).overlaps(b)) f(segments_[q]);
+            });
     }
 
   private:
@@ -157,14 +275,19 @@ class SegmentIndex {
     const Layer* layer_ = nullptr;
     std::vector<std::size_t> segments_;
     std::vector<std::size_t> position_;
-    detail::UniformGrid<std::uint32_t> grid_;
+    static constexpr std::size_t kChunk = 4;
+    double magnitude_ = 0.0;  // largest absolute coordinate of the layer
+    double chunk_length_ = 0.0;
+    std::vector<Box2> chunk_boxes_;  // chunk c: kept segments [c kChunk, (c + 1) kChunk)
+    detail::UniformGrid<std::uint32_t> chunk_grid_;
 };
 
 using Nearest = SegmentIndex::Nearest;
 
 // Closest point of the indexed layer to `p` if closer than `cutoff`.
-Nearest nearest_on(const SegmentIndex& index, const Vec2& p, double cutoff = kInf) {
-    return index.nearest(p, cutoff);
+Nearest nearest_on(const SegmentIndex& index, const Vec2& p, double cutoff = kInf,
+                   SegmentIndex::Cursor* cursor = nullptr) {
+    return index.nearest(p, cutoff, cursor);
 }
 
 double automatic_near(const Scene& scene) {
@@ -199,9 +322,10 @@ int side_of(const SegmentIndex& index, const Vec2& v, const Nearest& n) {
     return corner_side(index.start(before), index.end(before), index.end(after), v);
 }
 
-// side_of() at the closest point within `near`.
-int side_at(const SegmentIndex& index, const Vec2& v, double near) {
-    return side_of(index, v, nearest_on(index, v, near));
+// side_of() at the closest point within `near`; `cursor`: the previous vertex's query along
+// a polyline (see SegmentIndex::nearest()).
+int side_at(const SegmentIndex& index, const Vec2& v, double near, SegmentIndex::Cursor& cursor) {
+    return side_of(index, v, nearest_on(index, v, near, &cursor));
 }
 
 int closed_outside(const Layer& layer) {
@@ -225,11 +349,15 @@ int open_outside(const Scene& scene, std::size_t i, const SegmentIndex& index, d
     // distance), within kSideReach x near.
     for (const double reach : {near, kSideReach * near}) {
         long vote = 0;
-        for (std::size_t j : scene.inner_of(i))
-            for (const Vec2& v : scene.layer(j).points) vote -= side_at(index, v, reach);
+        for (std::size_t j : scene.inner_of(i)) {
+            SegmentIndex::Cursor cursor;
+            for (const Vec2& v : scene.layer(j).points) vote -= side_at(index, v, reach, cursor);
+        }
         if (vote != 0) return vote > 0 ? 1 : -1;
-        for (std::size_t j : scene.outer_of(i))
-            for (const Vec2& v : scene.layer(j).points) vote += side_at(index, v, reach);
+        for (std::size_t j : scene.outer_of(i)) {
+            SegmentIndex::Cursor cursor;
+            for (const Vec2& v : scene.layer(j).points) vote += side_at(index, v, reach, cursor);
+        }
         if (vote != 0) return vote > 0 ? 1 : -1;
     }
     return 1;
@@ -514,12 +642,13 @@ class Checker {
             const bool sides = sides_by_nearest(from, to);
             if (sides) sides_scanned_[from * n_ + to] = 1;
             const std::vector<Vec2>& points = scene_.layer(from).points;
+            SegmentIndex::Cursor cursor;  // the previous vertex's query
             for (std::size_t k = 0; k < points.size(); ++k) {
                 // Only a vertex closer than the pair's gap so far, or than required, changes
                 // the separation: the search stops there.
                 const double bound =
                     sides ? cutoff : std::max(threshold, std::min(cutoff, pair.gap));
-                const Nearest nr = nearest_on(indices_[to], points[k], bound);
+                const Nearest nr = nearest_on(indices_[to], points[k], bound, &cursor);
                 if (!nr.found()) continue;
                 if (sides && nr.distance < near &&
                     breaks_nesting(from, k, to, side_of(indices_[to], points[k], nr)))
@@ -613,6 +742,7 @@ class Checker {
         const Layer& other = scene_.layer(b);
         const std::vector<Vec2>& points = scene_.layer(a).points;
         std::vector<std::size_t>& out = wrong_side_[a * n_ + b];
+        SegmentIndex::Cursor cursor;
         for (std::size_t k = 0; k < points.size(); ++k) {
             bool broken = false;
             if (other.closed) {
@@ -620,8 +750,8 @@ class Checker {
                 broken = rel == Relation::Under ? where == Placement::Outside
                                                 : where == Placement::Inside;
             } else {
-                broken =
-                    breaks_nesting(a, k, b, side_at(indices_[b], points[k], report_.near_distance));
+                broken = breaks_nesting(
+                    a, k, b, side_at(indices_[b], points[k], report_.near_distance, cursor));
             }
             if (broken) out.push_back(k);
         }

@@ -194,6 +194,24 @@ class Scene {
                 ++queries_;
                 offered_ += offered.size();
             }
+            // nearest_within() from a candidate the caller measured (the brute-force winner
+            // or a farther item): the same winner.
+            if (!live_.empty()) {
+                Best brute;
+                for (const auto& [id, s] : live_) brute.offer(id, dist2(s, x));
+                auto it = live_.begin();
+                std::advance(it, static_cast<long>(rng_() % live_.size()));
+                for (const std::uint32_t seed : {brute.id, it->first}) {
+                    Best got;
+                    got.offer(seed, dist2(live_.at(seed), x));
+                    grid.nearest_within(x, std::sqrt(got.d2), [&](std::uint32_t id) {
+                        got.offer(id, dist2(live_.at(id), x));
+                        return got.d2;
+                    });
+                    REQUIRE(got.id == brute.id);
+                    REQUIRE(got.d2 == brute.d2);
+                }
+            }
         }
     }
 

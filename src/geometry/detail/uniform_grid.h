@@ -58,7 +58,7 @@ class UniformGrid {
         y0_ = y0;
         nx_ = x1 - x0 + 1;
         ny_ = y1 - y0 + 1;
-        dense_.resize(static_cast<std::size_t>(nx_ * ny_));
+        // dense_ is made by the first insert() (build() packs the cells instead).
     }
 
     /// The items of one cell, as read by the queries.
@@ -75,10 +75,7 @@ class UniformGrid {
 
     /// Empties every cell, keeping the cells and their capacity for the next fill.
     void clear() {
-        if (packed_) {
-            drop_packed();
-            dense_.resize(dense_cells());
-        }
+        if (packed_) drop_packed();
         for (auto& c : dense_) c.clear();
         for (auto& c : hashed_) c.second.clear();
         large_.clear();
@@ -131,6 +128,7 @@ class UniformGrid {
             return;
         }
         unpack();
+        if (dense_.empty()) dense_.resize(dense_cells());
         extend_range(c);
         for (long long i = c.i0; i <= c.i1; ++i)
             for (long long j = c.j0; j <= c.j1; ++j) slot(i, j).push_back(id);
@@ -260,6 +258,51 @@ class UniformGrid {
         }
     }
 
+    /// The same exact search as nearest(x, +inf, offer) for a caller that already holds a
+    /// candidate at distance `within` of x (scene units; from an item it measured itself, e.g.
+    /// the previous query's winner): offers the large items, then the items of the cells
+    /// meeting the square of half-side `within` around x, each cell only while it is not
+    /// farther than the best so far. Every item as near as the best is offered (ties included),
+    /// so the caller's tie-break gives the brute-force winner. A wide square (more cells than
+    /// kWithinCells) falls back to nearest().
+    template <class Offer>
+    void nearest_within(const Vec2& x, double within, Offer&& offer) const {
+        constexpr long long kWithinCells = 16;
+        if (!(within < std::numeric_limits<double>::infinity())) {
+            nearest(x, within, offer);
+            return;
+        }
+        double best2 = within * within;
+        for (const Id& id : large_) best2 = offer(id);
+        if (imin_ > imax_) return;
+        const double h = params_.cell;
+        const Vec2& o = params_.origin;
+        const double slack =
+            1e-9 * (h + std::abs(x.x) + std::abs(x.y) + std::abs(o.x) + std::abs(o.y));
+        const double reach = within + slack;
+        const long long i0 = std::max(column(x.x - reach), imin_);
+        const long long i1 = std::min(column(x.x + reach), imax_);
+        const long long j0 = std::max(row(x.y - reach), jmin_);
+        const long long j1 = std::min(row(x.y + reach), jmax_);
+        if (i0 > i1 || j0 > j1) return;
+        if ((i1 - i0 + 1) * (j1 - j0 + 1) > kWithinCells) {
+            nearest(x, std::numeric_limits<double>::infinity(), offer);
+            return;
+        }
+        for (long long i = i0; i <= i1; ++i) {
+            const double lo_x = o.x + static_cast<double>(i) * h - slack;
+            const double dx = std::max({lo_x - x.x, 0.0, x.x - (lo_x + h + 2.0 * slack)});
+            for (long long j = j0; j <= j1; ++j) {
+                const Items v = find(i, j);
+                if (v.empty()) continue;
+                const double lo_y = o.y + static_cast<double>(j) * h - slack;
+                const double dy = std::max({lo_y - x.y, 0.0, x.y - (lo_y + h + 2.0 * slack)});
+                if (dx * dx + dy * dy > best2) continue;
+                for (const Id& id : v) best2 = offer(id);
+            }
+        }
+    }
+
     /// Cells, their item lists and the hash table's nodes and bucket array, in bytes.
     std::size_t memory_bytes() const {
         std::size_t bytes = dense_.capacity() * sizeof(std::vector<Id>) +
@@ -357,6 +400,7 @@ class UniformGrid {
     }
     Items dense_items(std::size_t k) const {
         if (packed_) return {packed_ids_.data() + start_[k], packed_ids_.data() + start_[k + 1]};
+        if (dense_.empty()) return {};  // nothing inserted yet
         return {dense_[k].data(), dense_[k].data() + dense_[k].size()};
     }
     Items find(long long i, long long j) const {
@@ -367,7 +411,7 @@ class UniformGrid {
         return {it->second.data(), it->second.data() + it->second.size()};
     }
     std::vector<Id>* find_mutable(long long i, long long j) {
-        if (in_dense(i, j)) return &dense_[dense_index(i, j)];
+        if (in_dense(i, j)) return dense_.empty() ? nullptr : &dense_[dense_index(i, j)];
         const auto it = hashed_.find(key(i, j));
         return it == hashed_.end() ? nullptr : &it->second;
     }
