@@ -79,6 +79,8 @@ class SegmentIndex {
             lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));  // sizes the cells only
         }
         const double median = median_of(lengths);
+        ends_.reserve(segments_.size());
+        for (std::size_t s : segments_) ends_.push_back({start(s), end(s)});
         // The chunks of kChunk consecutive kept segments: what the grid files.
         std::vector<std::uint32_t> ids;
         for (std::size_t q = 0; q < segments_.size(); q += kChunk) {
@@ -91,7 +93,7 @@ class SegmentIndex {
         for (const Vec2& v : layer.points)
             magnitude_ = std::max({magnitude_, std::abs(v.x), std::abs(v.y)});
         chunk_length_ = static_cast<double>(kChunk) * median;
-        chunk_grid_ = segment_grid(bounds, median, segments_.size());
+        chunk_grid_ = segment_grid(bounds, median, chunk_boxes_.size());
         chunk_grid_.build(ids, [&](std::uint32_t c) { return chunk_boxes_[c]; });
     }
 
@@ -170,14 +172,16 @@ class SegmentIndex {
             const double cross = wx * dy - wy * dx;
             return cross * cross > guard2 * len2;
         };
-        auto offer = [&](std::size_t s) {
-            const Vec2 a = start(s), b = end(s);
-            if (far(a, b)) return;
+        // Kept segments are offered by their position q: their indices increase with it.
+        std::size_t best_q = kNone;
+        auto offer = [&](std::size_t q) {
+            const Ends& e = ends_[q];
+            if (far(e.a, e.b)) return;
             Vec2 closest;
-            const double d = point_segment_distance(p, a, b, &closest);
-            if (d < best.distance || (d == best.distance && s < best.segment)) {
+            const double d = point_segment_distance(p, e.a, e.b, &closest);
+            if (d < best.distance || (d == best.distance && q < best_q)) {
                 best.distance = d;
-                best.segment = s;
+                best_q = q;
                 best.point = closest;
                 best2 = d * d;
                 const double guard = d + 1e-9 * d + slack;
@@ -188,19 +192,18 @@ class SegmentIndex {
         std::size_t lo = 1, hi = 0;  // positions the walk offered: [lo, hi]
         if (hint != kNone) {
             lo = hi = position_[hint];
-            offer(hint);
+            offer(lo);
             while (hi + 1 < count) {
-                const std::size_t s = segments_[++hi];
-                offer(s);
-                if (best.segment != s) break;
+                offer(++hi);
+                if (best_q != hi) break;
             }
             while (lo > 0) {
-                const std::size_t s = segments_[--lo];
-                offer(s);
-                if (best.segment != s) break;
+                offer(--lo);
+                if (best_q != lo) break;
             }
             if (!(best.distance < cutoff)) {
                 best = Nearest{};
+                best_q = kNone;
                 best2 = kInf;
                 lo = 1;
                 hi = 0;
@@ -217,11 +220,11 @@ class SegmentIndex {
             const std::size_t q1 = std::min(q0 + kChunk, count);
             for (std::size_t q = q0; q < q1; ++q) {
                 if (lo <= q && q <= hi) continue;  // offered by the walk
-                offer(segments_[q]);
+                offer(q);
             }
             return best2;
         };
-        if (best.found() && cursor) {
+        if (best_q != kNone && cursor) {
             const Vec2 m = p - cursor->center;
             const double moved = std::sqrt(m.x * m.x + m.y * m.y);
             if (!(moved + best.distance + slack <= cursor->radius)) {
@@ -243,12 +246,15 @@ class SegmentIndex {
                     });
             }
             for (const std::uint32_t c : cursor->chunks) offer_chunk(c);
-        } else if (best.found()) {
+        } else if (best_q != kNone) {
             chunk_grid_.nearest_within(p, best.distance, offer_chunk);
         } else {
             chunk_grid_.nearest(p, cutoff, offer_chunk);
         }
-        if (!(best.distance < cutoff)) best = Nearest{};
+        if (best.distance < cutoff)
+            best.segment = segments_[best_q];
+        else
+            best = Nearest{};
         if (cursor) cursor->hint = best.segment;
         return best;
     }
@@ -275,7 +281,11 @@ class SegmentIndex {
     const Layer* layer_ = nullptr;
     std::vector<std::size_t> segments_;
     std::vector<std::size_t> position_;
-    static constexpr std::size_t kChunk = 4;
+    static constexpr std::size_t kChunk = 8;
+    struct Ends {
+        Vec2 a, b;
+    };
+    std::vector<Ends> ends_;  // the ends of each kept segment, by position
     double magnitude_ = 0.0;  // largest absolute coordinate of the layer
     double chunk_length_ = 0.0;
     std::vector<Box2> chunk_boxes_;  // chunk c: kept segments [c kChunk, (c + 1) kChunk)
