@@ -66,6 +66,8 @@ class SegmentIndex {
     SegmentIndex() = default;
 
     explicit SegmentIndex(const Layer& layer) : layer_(&layer) {
+        static std::atomic<std::uint64_t> serials{0};
+        serial_ = ++serials;
         const std::size_t count = layer.segment_count();
         position_.assign(count, kNone);
         for (std::size_t s = 0; s < count; ++s)
@@ -137,6 +139,7 @@ class SegmentIndex {
     /// What nearest() keeps from one query to the next along a polyline: the last nearest
     /// segment (where the next search starts) and the chunks within `radius` of `center`.
     struct Cursor {
+        std::uint64_t owner = 0;  // the index it was used with (0: none)
         std::size_t hint = kNone;
         Vec2 center{0.0};
         double radius = -1.0;  // none gathered yet
@@ -150,6 +153,10 @@ class SegmentIndex {
     /// when they hold every segment within d of p (else it gathers them again around p). The
     /// result does not depend on the cursor.
     Nearest nearest(const Vec2& p, double cutoff, Cursor* cursor = nullptr) const {
+        if (cursor && cursor->owner != serial_) {  // a cursor of another index: start afresh
+            *cursor = Cursor{};
+            cursor->owner = serial_;
+        }
         const std::size_t hint = cursor ? cursor->hint : kNone;
         Nearest best;
         double best2 = kInf;
@@ -228,9 +235,9 @@ class SegmentIndex {
             const Vec2 m = p - cursor->center;
             const double moved = std::sqrt(m.x * m.x + m.y * m.y);
             if (!(moved + best.distance + slack <= cursor->radius)) {
-                // Gathered with room for the next vertices: twice the distance and a chunk.
+                // Gathered with room for the next vertices (measured on the 8 x 10k stack).
                 cursor->center = p;
-                cursor->radius = 2.0 * best.distance + chunk_length_;
+                cursor->radius = 1.5 * best.distance + 0.5 * chunk_length_;
                 cursor->chunks.clear();
                 Box2 square;
                 const double r = cursor->radius + slack;
@@ -286,6 +293,7 @@ class SegmentIndex {
         Vec2 a, b;
     };
     std::vector<Ends> ends_;  // the ends of each kept segment, by position
+    std::uint64_t serial_ = 0;  // tells the cursors of this index (and its copies) from others
     double magnitude_ = 0.0;  // largest absolute coordinate of the layer
     double chunk_length_ = 0.0;
     std::vector<Box2> chunk_boxes_;  // chunk c: kept segments [c kChunk, (c + 1) kChunk)
@@ -513,7 +521,7 @@ class Checker {
                 boxes.push_back(indices_[i].box(s));
                 all.extend(boxes.back());
                 const Vec2 d = indices_[i].end(s) - indices_[i].start(s);
-                lengths.push_back(std::hypot(d.x, d.y));
+                lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));  // sizes the cells only
             }
         std::vector<std::uint32_t> ids(owner.size());
         for (std::size_t id = 0; id < ids.size(); ++id) ids[id] = static_cast<std::uint32_t>(id);
@@ -530,10 +538,14 @@ class Checker {
             const SegmentIndex& a = indices_[i];
             const Vec2 p0 = a.start(s), p1 = a.end(s);
             hits.clear();
-            grid.query_once(boxes[id], box_of, [&](std::uint32_t hit) {
-                if (hit > id) hits.push_back(hit);
+            // Each cell's later segments whose boxes meet this one's; a segment filed in
+            // several of these cells comes more than once: sorted, then made unique.
+            const Box2& own = boxes[id];
+            grid.query(own, [&](std::uint32_t hit) {
+                if (hit > id && boxes[hit].overlaps(own)) hits.push_back(hit);
             });
             std::sort(hits.begin(), hits.end());
+            hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
             for (const std::uint32_t hit : hits) {
                 const auto [j, t] = owner[hit];
                 const SegmentIndex& b = indices_[j];
@@ -799,8 +811,8 @@ double one_sided_hausdorff(const Layer& a, const SegmentIndex& b, double toleran
         End e0, e1;
         bool operator<(const Interval& other) const { return upper < other.upper; }
     };
-    auto evaluate = [&](const Vec2& p) {
-        const Nearest n = nearest_on(b, p);
+    auto evaluate = [&](const Vec2& p, SegmentIndex::Cursor* cursor = nullptr) {
+        const Nearest n = nearest_on(b, p, kInf, cursor);
         return End{p, n.distance, n.segment};
     };
     auto to_segment = [&](const Vec2& p, std::size_t s) {
@@ -820,8 +832,9 @@ double one_sided_hausdorff(const Layer& a, const SegmentIndex& b, double toleran
     };
     std::vector<End> vertices;
     vertices.reserve(a.points.size());
+    SegmentIndex::Cursor cursor;  // the vertices in order: each search starts at the last
     for (const Vec2& p : a.points) {
-        vertices.push_back(evaluate(p));
+        vertices.push_back(evaluate(p, &cursor));
         lower = std::max(lower, vertices.back().d);
     }
     const std::size_t count = a.segment_count();
@@ -933,7 +946,10 @@ struct InputSides::Recorded {
         if (c != kUnknown) return c;
         // Threads that ask at once find the same value.
         const SegmentIndex& other = index(b);
-        const Nearest nr = nearest_on(other, points[k], reach);
+        // Callers ask vertex after vertex: each thread's search starts where its last one
+        // ended on the same layer (the result does not depend on where it starts).
+        thread_local SegmentIndex::Cursor cursor;
+        const Nearest nr = nearest_on(other, points[k], reach, &cursor);
         const int side = side_of(other, points[k], nr);
         // Found, not on b, and no side: closest to an end point of b.
         c = side == 0 && nr.found() && nr.distance > 0.0 ? InputSides::kBeyondEnd
