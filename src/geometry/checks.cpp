@@ -217,8 +217,8 @@ class SegmentIndex {
             }
         }
         auto beyond = [&](const Box2& b) {
-            const double dx = std::max({b.min.x - p.x, 0.0, p.x - b.max.x});
-            const double dy = std::max({b.min.y - p.y, 0.0, p.y - b.max.y});
+            const double dx = std::max(std::max(b.min.x - p.x, p.x - b.max.x), 0.0);
+            const double dy = std::max(std::max(b.min.y - p.y, p.y - b.max.y), 0.0);
             return dx * dx + dy * dy > guard2;
         };
         auto offer_chunk = [&](std::uint32_t c) {
