@@ -363,20 +363,27 @@ int closed_outside(const Layer& layer) {
 constexpr double kSideReach = 3.0;
 
 int open_outside(const Scene& scene, std::size_t i, const SegmentIndex& index, double near) {
+    // The sum of sign x side over the vertices of `layers`; it stops once the vertices left
+    // (each -1, 0 or +1) can no longer change its sign.
+    auto tally = [&](const std::vector<std::size_t>& layers, int sign, double reach) {
+        long vote = 0, left = 0;
+        for (std::size_t j : layers) left += static_cast<long>(scene.layer(j).points.size());
+        for (std::size_t j : layers) {
+            SegmentIndex::Cursor cursor;
+            for (const Vec2& v : scene.layer(j).points) {
+                vote += sign * side_at(index, v, reach, cursor);
+                if (std::abs(vote) > --left) return vote;
+            }
+        }
+        return vote;
+    };
     // Within near; when that gives no vote either way (the neighbours lie at about the near
     // distance), within kSideReach x near.
     for (const double reach : {near, kSideReach * near}) {
-        long vote = 0;
-        for (std::size_t j : scene.inner_of(i)) {
-            SegmentIndex::Cursor cursor;
-            for (const Vec2& v : scene.layer(j).points) vote -= side_at(index, v, reach, cursor);
-        }
-        if (vote != 0) return vote > 0 ? 1 : -1;
-        for (std::size_t j : scene.outer_of(i)) {
-            SegmentIndex::Cursor cursor;
-            for (const Vec2& v : scene.layer(j).points) vote += side_at(index, v, reach, cursor);
-        }
-        if (vote != 0) return vote > 0 ? 1 : -1;
+        if (const long vote = tally(scene.inner_of(i), -1, reach); vote != 0)
+            return vote > 0 ? 1 : -1;
+        if (const long vote = tally(scene.outer_of(i), 1, reach); vote != 0)
+            return vote > 0 ? 1 : -1;
     }
     return 1;
 }
