@@ -70,11 +70,13 @@ class SegmentIndex {
         serial_ = ++serials;
         const std::size_t count = layer.segment_count();
         position_.assign(count, kNone);
+        segments_.reserve(count);
         for (std::size_t s = 0; s < count; ++s)
             if (layer.segment_start(s) != layer.segment_end(s)) add(s);
         if (segments_.empty() && count > 0) add(0);
         Box2 bounds;
         std::vector<double> lengths;
+        lengths.reserve(segments_.size());
         for (std::size_t s : segments_) {
             bounds.extend(box(s));
             const Vec2 d = end(s) - start(s);
@@ -85,6 +87,8 @@ class SegmentIndex {
         for (std::size_t s : segments_) ends_.push_back({start(s), end(s)});
         // The chunks of kChunk consecutive kept segments: what the grid files.
         std::vector<std::uint32_t> ids;
+        ids.reserve(segments_.size() / kChunk + 1);
+        chunk_boxes_.reserve(segments_.size() / kChunk + 1);
         for (std::size_t q = 0; q < segments_.size(); q += kChunk) {
             Box2 b;
             for (std::size_t r = q; r < std::min(q + kChunk, segments_.size()); ++r)
@@ -521,6 +525,11 @@ class Checker {
         std::vector<std::pair<std::size_t, std::size_t>> owner;
         std::vector<Box2> boxes;
         std::vector<double> lengths;
+        std::size_t total = 0;
+        for (std::size_t i = 0; i < n_; ++i) total += indices_[i].segments().size();
+        owner.reserve(total);
+        boxes.reserve(total);
+        lengths.reserve(total);
         Box2 all;
         for (std::size_t i = 0; i < n_; ++i)
             for (std::size_t s : indices_[i].segments()) {
