@@ -236,9 +236,11 @@ class SegmentIndex {
             return best2;
         };
         if (best_q != kNone && cursor) {
+            // The gathered chunks hold every segment within d of p when p moved at most
+            // radius - d from the center (slack: the rounding of these sums).
             const Vec2 m = p - cursor->center;
-            const double moved = std::sqrt(m.x * m.x + m.y * m.y);
-            if (!(moved + best.distance + slack <= cursor->radius)) {
+            const double room = cursor->radius - best.distance - slack;
+            if (!(room >= 0.0 && m.x * m.x + m.y * m.y <= room * room)) {
                 // Gathered with room for the next vertices (measured on the 8 x 10k stack).
                 cursor->center = p;
                 cursor->radius = 1.5 * best.distance + 0.5 * chunk_length_;
@@ -247,14 +249,16 @@ class SegmentIndex {
                 const double r = cursor->radius + slack;
                 square.extend(p - Vec2(r));
                 square.extend(p + Vec2(r));
-                chunk_grid_.query_once(
-                    square, [&](std::uint32_t c) { return chunk_boxes_[c]; },
-                    [&](std::uint32_t c) {
-                        const Box2& b = chunk_boxes_[c];
-                        const double dx = std::max({b.min.x - p.x, 0.0, p.x - b.max.x});
-                        const double dy = std::max({b.min.y - p.y, 0.0, p.y - b.max.y});
-                        if (dx * dx + dy * dy <= r * r) cursor->chunks.push_back(c);
-                    });
+                // A chunk filed in several cells comes once per cell: sorted, made unique.
+                chunk_grid_.query(square, [&](std::uint32_t c) {
+                    const Box2& b = chunk_boxes_[c];
+                    const double dx = std::max(std::max(b.min.x - p.x, p.x - b.max.x), 0.0);
+                    const double dy = std::max(std::max(b.min.y - p.y, p.y - b.max.y), 0.0);
+                    if (dx * dx + dy * dy <= r * r) cursor->chunks.push_back(c);
+                });
+                std::sort(cursor->chunks.begin(), cursor->chunks.end());
+                cursor->chunks.erase(std::unique(cursor->chunks.begin(), cursor->chunks.end()),
+                                     cursor->chunks.end());
             }
             for (const std::uint32_t c : cursor->chunks) offer_chunk(c);
         } else if (best_q != kNone) {
