@@ -499,7 +499,7 @@ Vec2 touch_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1)
 // Adjacent segments [u, v] and [v, w] that fold back onto each other: collinear, opposite
 // directions. Sets `point` to the representative point of their overlap.
 bool folds_back(const Vec2& u, const Vec2& v, const Vec2& w, Vec2& point) {
-    if (orient2d(u, v, w) != 0) return false;
+    if (orient_filtered(u, v, w) != 0) return false;
     const bool use_x = u.x != v.x;
     const double cu = use_x ? u.x : u.y, cv = use_x ? v.x : v.y, cw = use_x ? w.x : w.y;
     if ((cv > cu) == (cw > cv)) return false;
