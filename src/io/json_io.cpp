@@ -438,9 +438,12 @@ class FastScene {
         const bool read = object([&](std::string_view key) {
             if (key == "name") return string(l.name);
             if (key == "closed") {
-                if (literal("true")) return l.closed = true;
-                if (literal("false")) return !(l.closed = false);
-                return false;
+                if (literal("true")) {
+                    l.closed = true;
+                    return true;
+                }
+                l.closed = false;
+                return literal("false");
             }
             if (key == "thickness") return number(l.thickness);
             if (key == "weight") return number(l.weight);
