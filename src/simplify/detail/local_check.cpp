@@ -51,13 +51,16 @@ LocalCheck::LocalCheck(const Scene& input, const LivePolylines& live,
       separations_(separations),
       outside_signs_(outside_signs),
       sides_(sides),
-      reach_(automatic_near_distance(input)) {
-    for (std::size_t k = 0; k < input.size() && !open_nesting_; ++k)
+      reach_(automatic_near_distance(input)),
+      open_under_over_(input.size(), 0),
+      under_or_over_open_(input.size(), 0) {
+    for (std::size_t k = 0; k < input.size(); ++k)
         for (std::size_t j = 0; j < input.size() && !input.layer(k).closed; ++j) {
             const Relation r = input.relation(j, k);
-            if (r == Relation::Under || r == Relation::Over) {
+            if (j != k && (r == Relation::Under || r == Relation::Over)) {
+                open_under_over_[k] = 1;
+                under_or_over_open_[j] = 1;
                 open_nesting_ = true;
-                break;
             }
         }
 }
@@ -219,43 +222,45 @@ bool LocalCheck::nesting_kept(std::size_t l, const std::vector<std::size_t>& ids
     return true;
 }
 
-void LocalCheck::sides_against(const Vec2& p, const Overlay& ov,
-                               std::vector<Closest>& closest) const {
+// One box query for the whole job: every segment of an open layer within reach_ of one of the
+// points tested is in it. The closest segment of a layer to a point is then the smallest
+// (distance, index) among its segments closer than reach_, as check_scene() finds it; boxes
+// growing from the largest separation, one query per size and per point, found the same
+// segments (measured: 3.1 queries per point at 8 x 10k, 98%, 10% of the process).
+void LocalCheck::segments_near(const Box2& box, const Overlay& ov,
+                               std::vector<std::vector<NearSegment>>& near) const {
+    near.assign(live_.size(), {});
+    ov.near(box, [&](std::size_t k, std::size_t u) {
+        if (live_.layer(k).closed || !open_under_over_[k]) return;
+        const Vec2 a = ov.pos(k, u), b = ov.pos(k, live_.layer(k).next[u]);
+        if (a == b) return;  // zero length: its point is an end of its neighbours
+        NearSegment s{u, a, b, Box2{}};
+        s.box.extend(a);
+        s.box.extend(b);
+        near[k].push_back(s);
+    });
+}
+
+LocalCheck::Closest LocalCheck::closest_of(const Vec2& p,
+                                           const std::vector<NearSegment>& segments) const {
     Box2 box;
     box.extend(p);
-    std::size_t open = 0;  // layers still looking
-    for (const Closest& c : closest) open += c.wanted && !c.settled;
-    // Boxes growing from the largest separation to reach_: every segment closer than r meets
-    // the box inflated by r, so a closest one found within r is the closest. One box query
-    // serves every layer still looking.
-    for (double r = std::min(reach_, std::max(separations_.max_reach, 1e-3 * reach_)); open > 0;
-         r = std::min(reach_, 2.0 * r)) {
-        for (Closest& c : closest)
-            if (c.wanted && !c.settled) {
-                c.best = reach_;
-                c.seg = kNone;
-            }
-        ov.near(box.inflated(r), [&](std::size_t k, std::size_t u) {
-            Closest& c = closest[k];
-            if (!c.wanted || c.settled) return;
-            const Vec2 a = ov.pos(k, u), b = ov.pos(k, live_.layer(k).next[u]);
-            if (a == b) return;  // zero length: its point is an end of its neighbours
-            Vec2 q;
-            const double d = point_segment_distance(p, a, b, &q);
-            // check_scene(): the segment of smallest index among equally close ones (input
-            // ids run in layer order on an open layer).
-            if (d < c.best || (d == c.best && c.seg != kNone && u < c.seg)) {
-                c.best = d;
-                c.seg = u;
-                c.point = q;
-            }
-        });
-        for (Closest& c : closest)
-            if (c.wanted && !c.settled && ((c.seg != kNone && c.best <= r) || r >= reach_)) {
-                c.settled = true;
-                --open;
-            }
+    const Box2 reach = box.inflated(reach_);
+    Closest c;
+    c.best = reach_;
+    for (const NearSegment& s : segments) {
+        if (!s.box.overlaps(reach)) continue;
+        Vec2 q;
+        const double d = point_segment_distance(p, s.a, s.b, &q);
+        // check_scene(): the segment of smallest index among equally close ones (input ids
+        // run in layer order on an open layer).
+        if (d < c.best || (d == c.best && c.seg != kNone && s.start < c.seg)) {
+            c.best = d;
+            c.seg = s.start;
+            c.point = q;
+        }
     }
+    return c;
 }
 
 int LocalCheck::side_of_closest(std::size_t k, const Vec2& p, const Closest& c,
@@ -276,20 +281,15 @@ int LocalCheck::side_of_closest(std::size_t k, const Vec2& p, const Closest& c,
 }
 
 bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
-                             std::vector<Closest>& closest) const {
+                             const std::vector<std::vector<NearSegment>>& near) const {
     const Vec2 p = ov.pos(j, x);
-    closest.assign(live_.size(), Closest{});
     for (std::size_t k = 0; k < live_.size(); ++k) {
         if (k == j || live_.layer(k).closed) continue;
         const Relation r = input_.relation(j, k);
-        closest[k].wanted = r == Relation::Under || r == Relation::Over;
-    }
-    sides_against(p, ov, closest);
-    for (std::size_t k = 0; k < live_.size(); ++k) {
-        if (!closest[k].wanted) continue;
+        if (r != Relation::Under && r != Relation::Over) continue;
         int wanted = sides_.side(j, x, k);
-        if (wanted == 0) wanted = global_side(input_.relation(j, k), outside_signs_[k]);
-        const int side = side_of_closest(k, p, closest[k], ov);
+        if (wanted == 0) wanted = global_side(r, outside_signs_[k]);
+        const int side = side_of_closest(k, p, closest_of(p, near[k]), ov);
         if (side != 0 && side != wanted) return false;
     }
     return true;
@@ -298,23 +298,35 @@ bool LocalCheck::keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
 bool LocalCheck::sides_kept(const Overlay& ov) const {
     if (!open_nesting_) return true;
     const Job& job = *ov.job();
-    std::vector<Closest> closest;
+    // The points tested: the free vertices, and the ends of the open layers near the job,
+    // moved or not: at a high removal a rolled part is often down to the end of its layer,
+    // whose side changes when the layer it lies over is moved under it (the one unmoved case
+    // tested here; see the header).
+    std::vector<SegRef> points;
+    Box2 box;
     for (std::size_t r = 0; r < job.runs.size(); ++r) {
         const Run& run = job.runs[r];
         for (std::size_t i = 0; i < run.ids.size(); ++i)
-            if (job.pieces[r].is_free[i] && !keeps_sides(run.layer, run.ids[i], ov, closest))
-                return false;
+            if (job.pieces[r].is_free[i] && under_or_over_open_[run.layer]) {
+                points.push_back(LivePolylines::ref(run.layer, run.ids[i]));
+                box.extend(ov.pos(run.layer, run.ids[i]));
+            }
     }
-    // The ends of the open layers near the job, moved or not: at a high removal a rolled part
-    // is often down to the end of its layer, whose side changes when the layer it lies over
-    // is moved under it (the one unmoved case tested here; see the header).
-    const Box2 near = span_of(job).inflated(reach_);
+    const Box2 span = span_of(job).inflated(reach_);
     for (std::size_t j = 0; j < live_.size(); ++j) {
         const WorkLayer& w = live_.layer(j);
         if (w.closed || w.pos.empty()) continue;
         for (const std::size_t end : {std::size_t{0}, w.pos.size() - 1})
-            if (near.contains(ov.pos(j, end)) && !keeps_sides(j, end, ov, closest)) return false;
+            if (under_or_over_open_[j] && span.contains(ov.pos(j, end))) {
+                points.push_back(LivePolylines::ref(j, end));
+                box.extend(ov.pos(j, end));
+            }
     }
+    if (points.empty()) return true;
+    std::vector<std::vector<NearSegment>> near;
+    segments_near(box.inflated(reach_), ov, near);
+    for (const SegRef& x : points)
+        if (!keeps_sides(x.layer, x.start, ov, near)) return false;
     return true;
 }
 
