@@ -145,8 +145,13 @@ class SegmentCells {
     double drift_ = 0.0;                    // largest move since the build
 };
 
+// p lies in the closed triangle (a, b, c). The side (a, b) is tested last, and only when the
+// other two leave p possibly inside: is_safe() passes a vertex's move there, often so short
+// that orient2d() on it falls to its exact (rational) stage.
 bool in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
-    const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    const int o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    if (o2 * o3 < 0) return false;
+    const int o1 = orient2d(a, b, p);
     return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
 }
 
@@ -284,9 +289,11 @@ class Finisher {
         if (found_.empty()) return;
         // The nearest segment of each layer, and whether the vertex is on its wrong side.
         nearest_.clear();
+        distance_.resize(found_.size());
         for (std::size_t i = 0; i < found_.size(); ++i) {
             const SegId& s = found_[i];
             const double d = point_segment_distance(pts_[l][v], cells_->start(s), cells_->end(s));
+            distance_[i] = d;
             auto it = std::find_if(nearest_.begin(), nearest_.end(),
                                    [&](const Nearest& x) { return x.layer == s.layer; });
             if (it == nearest_.end())
@@ -308,6 +315,7 @@ class Finisher {
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
                          orient2d(q0, q1, p) != wanted;
         }
+        const std::size_t moves_before = result.moves;
         for (std::size_t i = 0; i < found_.size(); ++i) {
             const SegId& s = found_[i];
             const std::size_t m = s.layer;
@@ -315,6 +323,8 @@ class Finisher {
                                                 [&](const Nearest& x) { return x.layer == m; });
             if (near.is_wrong && near.index != i) continue;  // the tangle first
             const double aim = aim_[l * n + m];
+            // Nothing moved yet in this call: the distance measured above is the one below.
+            if (!near.is_wrong && result.moves == moves_before && !(distance_[i] < aim)) continue;
             const std::size_t k0 = s.index, k1 = (s.index + 1) % layer_size(m);
             const Vec2 p = pts_[l][v], q0 = pts_[m][k0], q1 = pts_[m][k1];
             const double wp = inverse_mass_[l][v], w0 = inverse_mass_[m][k0],
@@ -478,7 +488,7 @@ class Finisher {
             for (std::size_t e = 0; e < 2 && safe; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
                 const Vec2 w = pts_[s.layer][ends[e]];
-                if (has_prev && in_closed_triangle(pts_[l][prev], p, to, w)) safe = false;
+                if (has_prev && in_closed_triangle(p, to, pts_[l][prev], w)) safe = false;
                 if (has_next && in_closed_triangle(p, to, pts_[l][next], w)) safe = false;
             }
         });
@@ -507,6 +517,7 @@ class Finisher {
     std::optional<SegmentCells> cells_;
     std::vector<SegId> active_;  // (layer, vertex) of the vertices near the free ones
     std::vector<SegId> found_;
+    std::vector<double> distance_;  // from the vertex relaxed to each of found_, as found
     double worst_ = 0.0;
     std::size_t wrong_side_ = 0;
 };
