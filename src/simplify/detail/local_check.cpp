@@ -14,11 +14,9 @@ namespace {
 // p lies in the closed triangle (a, b, c). The box test first: it is exact, rejects most
 // points without a predicate, and is what decides for a flat triangle (collinear a, b, c),
 // where every point of the line through them has three zero orientations.
-bool point_in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
-    Box2 box;
-    box.extend(a);
-    box.extend(b);
-    box.extend(c);
+// `box`: the box of a, b and c.
+bool point_in_closed_triangle(const Box2& box, const Vec2& a, const Vec2& b, const Vec2& c,
+                              const Vec2& p) {
     if (!box.contains(p)) return false;
     const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
     return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
@@ -130,9 +128,13 @@ bool LocalCheck::triangle_empty(std::size_t l, std::size_t a, const Vec2& remove
     bool ok = true;
     ov.near(box, [&](std::size_t k, std::size_t u) {
         if (!ok) return;
-        for (std::size_t x : {u, live_.layer(k).next[u]}) {
+        const std::vector<std::size_t>& next = live_.layer(k).next;
+        for (std::size_t x : {u, next[u]}) {
+            // Each vertex once: as the start of its segment (which meets the box when the
+            // vertex is in it), the last one of an open layer as an end.
+            if (x != u && next[x] != kNone) continue;
             if (k == l && (x == a || x == b)) continue;
-            if (point_in_closed_triangle(pa, removed, pb, ov.pos(k, x))) {
+            if (point_in_closed_triangle(box, pa, removed, pb, ov.pos(k, x))) {
                 // After an untangling the triangle is no longer swept: a vertex of another
                 // layer may have moved into it from the side it belongs on.
                 if (ov.job() && k != l && on_wanted_side(k, l, pa, pb, ov.pos(k, x))) continue;
