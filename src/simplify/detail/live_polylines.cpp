@@ -69,7 +69,7 @@ void LivePolylines::unlink(std::size_t l, std::size_t v) {
     w.prev[b] = a;
     --w.alive_count;
     grid_.insert(ref(l, a), seg_box(l, a));
-    if (--live_segments_ * 2 < gridded_segments_) regrid();
+    if (--live_segments_ * 4 < gridded_segments_) regrid();
 }
 
 void LivePolylines::relink(std::size_t l, std::size_t v) {
