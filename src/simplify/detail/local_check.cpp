@@ -63,37 +63,55 @@ LocalCheck::LocalCheck(const Scene& input, const LivePolylines& live,
         }
 }
 
+// One query serves both tests: the box of the triangle and the chord's inflated by its
+// reach (two queries, the triangle's and the chord's, read the same cells twice).
 bool LocalCheck::removal_clear(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
                                const Overlay& ov) const {
-    return closed_valid(l, ov) && triangle_empty(l, a, removed, b, ov) &&
-           segment_clear(l, a, b, ov);
+    if (!closed_valid(l, ov)) return false;
+    const Chord chord = chord_of(l, a, b, ov);
+    Triangle triangle{l, a, b, chord.p, removed, chord.q, chord.box};
+    triangle.box.extend(removed);
+    Box2 query = chord.box.inflated(separations_.reach[l]);
+    query.extend(triangle.box);
+    bool ok = true;
+    ov.near(query, [&](std::size_t k, std::size_t u) {
+        ok = ok && clear_of_triangle(triangle, k, u, ov) && clear_of_chord(chord, k, u, ov);
+    });
+    return ok;
 }
 
 bool LocalCheck::segment_clear(std::size_t l, std::size_t a, std::size_t b,
                                const Overlay& ov) const {
-    const Vec2 p = ov.pos(l, a), q = ov.pos(l, b);
-    Box2 box;
-    box.extend(p);
-    box.extend(q);
+    const Chord chord = chord_of(l, a, b, ov);
     bool ok = true;
-    ov.near(box.inflated(separations_.reach[l]), [&](std::size_t k, std::size_t u) {
-        if (!ok) return;
-        const std::size_t u2 = live_.layer(k).next[u];
-        if (k == l && (u == a || u == b || u2 == a || u2 == b)) return;
-        const Vec2 s0 = ov.pos(k, u), s1 = ov.pos(k, u2);
-        Box2 other;
-        other.extend(s0);
-        other.extend(s1);
-        // Segments meet only where their boxes do (exact comparisons).
-        if (other.overlaps(box) && segment_contact(p, q, s0, s1) != SegmentContact::None) {
-            ok = false;
-            return;
-        }
-        const double need = separations_.need[l][k];
-        if (k == l || !(need > 0.0) || apart_by_more(box, other, need)) return;
-        if (segment_distance(p, q, s0, s1) < need) ok = false;
+    ov.near(chord.box.inflated(separations_.reach[l]), [&](std::size_t k, std::size_t u) {
+        ok = ok && clear_of_chord(chord, k, u, ov);
     });
     return ok;
+}
+
+LocalCheck::Chord LocalCheck::chord_of(std::size_t l, std::size_t a, std::size_t b,
+                                       const Overlay& ov) const {
+    Chord c{l, a, b, ov.pos(l, a), ov.pos(l, b), Box2{}};
+    c.box.extend(c.p);
+    c.box.extend(c.q);
+    return c;
+}
+
+bool LocalCheck::clear_of_chord(const Chord& c, std::size_t k, std::size_t u,
+                                const Overlay& ov) const {
+    const std::size_t u2 = live_.layer(k).next[u];
+    if (k == c.l && (u == c.a || u == c.b || u2 == c.a || u2 == c.b)) return true;
+    const Vec2 s0 = ov.pos(k, u), s1 = ov.pos(k, u2);
+    Box2 other;
+    other.extend(s0);
+    other.extend(s1);
+    // Segments meet only where their boxes do (exact comparisons).
+    if (other.overlaps(c.box) && segment_contact(c.p, c.q, s0, s1) != SegmentContact::None)
+        return false;
+    const double need = separations_.need[c.l][k];
+    if (k == c.l || !(need > 0.0) || apart_by_more(c.box, other, need)) return true;
+    return !(segment_distance(c.p, c.q, s0, s1) < need);
 }
 
 bool LocalCheck::closed_valid(std::size_t l, const Overlay& ov) const {
@@ -115,35 +133,26 @@ bool LocalCheck::on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, co
     return orient2d(pa, pb, w) == wanted;
 }
 
-// No vertex but a, b of any layer lies in the closed triangle (a, removed, b). Over a job
+// No vertex of segment (k, u) but a, b lies in the closed triangle. Each vertex is tested
+// once over a query that holds the triangle's box: as the start of its segment (which meets
+// the box when the vertex is in it), the last one of an open layer as an end. Over a job
 // (after its untangling), a vertex of another layer on its own side of the chord (a, b) is
 // allowed there.
-bool LocalCheck::triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
-                                const Overlay& ov) const {
-    const Vec2 pa = ov.pos(l, a), pb = ov.pos(l, b);
-    Box2 box;
-    box.extend(pa);
-    box.extend(pb);
-    box.extend(removed);
-    bool ok = true;
-    ov.near(box, [&](std::size_t k, std::size_t u) {
-        if (!ok) return;
-        const std::vector<std::size_t>& next = live_.layer(k).next;
-        for (std::size_t x : {u, next[u]}) {
-            // Each vertex once: as the start of its segment (which meets the box when the
-            // vertex is in it), the last one of an open layer as an end.
-            if (x != u && next[x] != kNone) continue;
-            if (k == l && (x == a || x == b)) continue;
-            if (point_in_closed_triangle(box, pa, removed, pb, ov.pos(k, x))) {
-                // After an untangling the triangle is no longer swept: a vertex of another
-                // layer may have moved into it from the side it belongs on.
-                if (ov.job() && k != l && on_wanted_side(k, l, pa, pb, ov.pos(k, x))) continue;
-                ok = false;
-                return;
-            }
+bool LocalCheck::clear_of_triangle(const Triangle& t, std::size_t k, std::size_t u,
+                                   const Overlay& ov) const {
+    const std::vector<std::size_t>& next = live_.layer(k).next;
+    for (std::size_t x : {u, next[u]}) {
+        if (x != u && next[x] != kNone) continue;
+        if (k == t.l && (x == t.a || x == t.b)) continue;
+        const Vec2 w = ov.pos(k, x);
+        if (point_in_closed_triangle(t.box, t.pa, t.removed, t.pb, w)) {
+            // After an untangling the triangle is no longer swept: a vertex of another layer
+            // may have moved into it from the side it belongs on.
+            if (ov.job() && k != t.l && on_wanted_side(k, t.l, t.pa, t.pb, w)) continue;
+            return false;
         }
-    });
-    return ok;
+    }
+    return true;
 }
 
 // The segments of closed layer k that the overlay's job changes, as (start, end) pairs: their

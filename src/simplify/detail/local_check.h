@@ -77,8 +77,23 @@ class LocalCheck {
                      const std::vector<std::vector<NearSegment>>& near) const;
     bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
                         const Vec2& w) const;
-    bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
-                        const Overlay& ov) const;
+    /// Segment (a, b) of layer l at its overlay positions p, q, and their box.
+    struct Chord {
+        std::size_t l, a, b;
+        Vec2 p, q;
+        Box2 box;
+    };
+    Chord chord_of(std::size_t l, std::size_t a, std::size_t b, const Overlay& ov) const;
+    /// Segment (k, u) meets the chord nowhere and keeps its separation from it.
+    bool clear_of_chord(const Chord& c, std::size_t k, std::size_t u, const Overlay& ov) const;
+    /// The closed triangle (pa, removed, pb) of a removal between a and b of layer l, its box.
+    struct Triangle {
+        std::size_t l, a, b;
+        Vec2 pa, removed, pb;
+        Box2 box;
+    };
+    bool clear_of_triangle(const Triangle& t, std::size_t k, std::size_t u,
+                           const Overlay& ov) const;
     void changed_segments(std::size_t k, const Overlay& ov, std::vector<Vec2>& olds,
                           std::vector<Vec2>& news) const;
 
