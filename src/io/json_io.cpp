@@ -4,12 +4,16 @@
 #include "strata/core/format.h"
 #include "strata/io/atomic_file.h"
 
+#include <simdjson.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -286,6 +290,138 @@ class SceneSax {
     std::string capture_key_;
 };
 
+// The common scene read by simdjson's DOM parser (which picks the CPU's SIMD kernels at run
+// time), before the readers below: every key one strata knows, numbers and strings as
+// nlohmann reads them (an integer token as a 64-bit integer, so "-0" is +0; strings
+// unescaped). Anything else (an unknown key, whose value must be kept as written; a duplicate
+// key; a syntax or type error; a number out of range) makes read() return false, and the
+// readers below take the text and name what is wrong.
+class FastScene {
+  public:
+    // `text` followed by `capacity` - text.size() readable bytes: simdjson reads up to
+    // SIMDJSON_PADDING bytes past the end, and copies a text without that room.
+    bool read(std::string_view text, std::size_t capacity) {
+        simdjson::dom::parser parser;
+        simdjson::dom::element root;
+        const bool parsed =
+            capacity >= text.size() + simdjson::SIMDJSON_PADDING
+                ? !parser.parse(simdjson::padded_string_view(text.data(), text.size(), capacity))
+                       .get(root)
+                : !parser.parse(text.data(), text.size()).get(root);
+        if (!parsed) return false;
+        bool has_layers = false;
+        const bool read = fields(root, [&](std::string_view key, simdjson::dom::element v) {
+            if (key == "strata") {
+                const auto type = v.type();
+                return (type == simdjson::dom::element_type::INT64 ||
+                        type == simdjson::dom::element_type::UINT64) &&
+                       number(v) == 1.0;
+            }
+            if (key == "units") return string(v, units);
+            if (key == "layers") {
+                has_layers = true;
+                return items(v, [&](simdjson::dom::element item) { return layer(item); });
+            }
+            return false;
+        });
+        return read && has_layers && !layers.empty();
+    }
+
+    std::string units;
+    std::vector<Layer> layers;
+
+  private:
+    // The number `v` as a double (NaN when it is not a number, which no JSON number reads as).
+    static double number(simdjson::dom::element v) {
+        switch (v.type()) {
+            case simdjson::dom::element_type::INT64:
+                return static_cast<double>(v.get_int64().value_unsafe());
+            case simdjson::dom::element_type::UINT64:
+                return static_cast<double>(v.get_uint64().value_unsafe());
+            case simdjson::dom::element_type::DOUBLE:
+                return v.get_double().value_unsafe();
+            default:
+                return std::numeric_limits<double>::quiet_NaN();
+        }
+    }
+    static bool number(simdjson::dom::element v, double& out) {
+        out = number(v);
+        return !std::isnan(out);
+    }
+    static bool string(simdjson::dom::element v, std::string& out) {
+        std::string_view s;
+        if (v.get_string().get(s)) return false;
+        out.assign(s);
+        return true;
+    }
+    // Calls item(element) for each element of the array `v`; false when `v` is not an array or
+    // an item() fails.
+    template <class Item>
+    static bool items(simdjson::dom::element v, Item&& item) {
+        simdjson::dom::array array;
+        if (v.get_array().get(array)) return false;
+        for (simdjson::dom::element element : array)
+            if (!item(element)) return false;
+        return true;
+    }
+    // Calls value(key, element) for each field of the object `v`; false when `v` is not an
+    // object, on a duplicate key, or when a value() fails.
+    template <class Value>
+    static bool fields(simdjson::dom::element v, Value&& value) {
+        simdjson::dom::object object;
+        if (v.get_object().get(object)) return false;
+        std::vector<std::string_view> seen;
+        for (const simdjson::dom::key_value_pair field : object) {
+            if (std::find(seen.begin(), seen.end(), field.key) != seen.end()) return false;
+            seen.push_back(field.key);
+            if (!value(field.key, field.value)) return false;
+        }
+        return true;
+    }
+    bool layer(simdjson::dom::element v) {
+        Layer& l = layers.emplace_back();
+        l.name = "layer_" + std::to_string(layers.size() - 1);
+        bool has_points = false;
+        const bool read = fields(v, [&](std::string_view key, simdjson::dom::element x) {
+            if (key == "name") return string(x, l.name);
+            if (key == "closed") return !x.get_bool().get(l.closed);
+            if (key == "thickness") return number(x, l.thickness);
+            if (key == "weight") return number(x, l.weight);
+            if (key == "alpha" || key == "beta") {
+                if (x.is_null()) return true;
+                double a = 0.0;
+                if (!number(x, a)) return false;
+                (key == "alpha" ? l.alpha : l.beta) = a;
+                return true;
+            }
+            if (key == "outer") {
+                l.outer.emplace();
+                return items(x, [&](simdjson::dom::element name) {
+                    return string(name, l.outer->emplace_back());
+                });
+            }
+            if (key == "points") {
+                has_points = true;
+                simdjson::dom::array points;
+                if (x.get_array().get(points)) return false;
+                l.points.reserve(points.size());
+                return items(x, [&](simdjson::dom::element point) {
+                    simdjson::dom::array xy;
+                    double px = 0.0, py = 0.0;
+                    if (point.get_array().get(xy) || xy.size() != 2 ||
+                        !number(xy.at(0).value_unsafe(), px) ||
+                        !number(xy.at(1).value_unsafe(), py))
+                        return false;
+                    l.points.emplace_back(px, py);
+                    return true;
+                });
+            }
+            return false;
+        });
+        return read && has_points;
+    }
+};
+
 class Reader {
   public:
     explicit Reader(std::string source) : source_(std::move(source)) {}
@@ -361,7 +497,8 @@ class Reader {
         return layer;
     }
 
-    Scene scene(std::string_view text) const {
+    // `capacity`: FastScene::read().
+    Scene scene(std::string_view text, std::size_t capacity = 0) const {
         if (const std::size_t deep = too_deep_at(text); deep != std::string_view::npos) {
             const auto [line, column] = line_column(text, deep);
             throw InvalidInput(source_ + ":" + std::to_string(line) + ":" + std::to_string(column) +
@@ -369,6 +506,8 @@ class Reader {
                                std::to_string(kMaxJsonDepth) + " levels (found '" +
                                std::string(1, text[deep]) + "')");
         }
+        if (FastScene fast; fast.read(text, capacity))
+            return finish(std::move(fast.layers), fast.units, {});
         SceneSax sax;
         const bool read = json::sax_parse(text.begin(), text.end(), &sax);
         if (read && sax.has_layers && !sax.layers.empty())
@@ -515,7 +654,8 @@ std::string scene_to_json(const Scene& scene) {
 }
 
 Scene read_scene_json(const std::filesystem::path& path) {
-    return parse_scene_json(read_text_file(path), path.string());
+    const std::string text = read_text_file(path);  // with room to spare: read_text_file()
+    return Reader(path.string()).scene(text, text.capacity());
 }
 
 void write_scene_json(const Scene& scene, const std::filesystem::path& path) {
