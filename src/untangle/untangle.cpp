@@ -122,7 +122,88 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
     return report;
 }
 
+// Unit tangents of open `layer` at `count` points evenly spaced along its length.
+std::vector<Vec2> tangents_along(const Layer& layer, std::size_t count) {
+    std::vector<Vec2> out;
+    const double total = layer.length();
+    if (!(total > 0.0)) return out;
+    std::size_t segment = 0;
+    double before = 0.0;  // length of the segments before `segment`
+    for (std::size_t k = 0; k < count; ++k) {
+        const double at = (static_cast<double>(k) + 0.5) / static_cast<double>(count) * total;
+        while (segment + 1 < layer.segment_count() &&
+               before + glm::distance(layer.segment_start(segment), layer.segment_end(segment)) <
+                   at) {
+            before += glm::distance(layer.segment_start(segment), layer.segment_end(segment));
+            ++segment;
+        }
+        const Vec2 d = layer.segment_end(segment) - layer.segment_start(segment);
+        const double len = glm::length(d);
+        out.push_back(len > 0.0 ? d / len : Vec2(0.0));
+    }
+    return out;
+}
+
 }  // namespace
+
+std::vector<int> untangling_outside_sides(const Scene& scene) {
+    std::vector<int> sides = outside_sides(scene);
+    const std::size_t n = scene.size();
+    // Directly related open layers that run along each other (the mean cosine of their
+    // tangents at the same fraction of their lengths beyond +-kParallel): the same outside
+    // side when they travel the same way, opposite ones when they travel opposite ways.
+    constexpr std::size_t kSamples = 64;
+    constexpr double kParallel = 0.8;
+    std::vector<std::vector<Vec2>> tangents(n);
+    for (std::size_t i = 0; i < n; ++i)
+        if (!scene.layer(i).closed) tangents[i] = tangents_along(scene.layer(i), kSamples);
+    // Components of such pairs, with each layer's parity to its component's first layer.
+    std::vector<std::size_t> component(n);
+    std::vector<int> parity(n, 1);
+    for (std::size_t i = 0; i < n; ++i) component[i] = i;
+    bool linked = false;
+    for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b : scene.outer_of(a)) {
+            if (tangents[a].size() != kSamples || tangents[b].size() != kSamples) continue;
+            double cosine = 0.0;
+            for (std::size_t k = 0; k < kSamples; ++k)
+                cosine += glm::dot(tangents[a][k], tangents[b][k]);
+            cosine /= static_cast<double>(kSamples);
+            if (std::abs(cosine) < kParallel) continue;
+            const int together = cosine > 0.0 ? 1 : -1;
+            const std::size_t ca = component[a], cb = component[b];
+            if (ca == cb) continue;  // the first link found decides
+            const int flip = parity[a] * parity[b] * together;
+            for (std::size_t i = 0; i < n; ++i)
+                if (component[i] == cb) {
+                    component[i] = ca;
+                    parity[i] *= flip;
+                }
+            linked = true;
+        }
+    if (!linked) return sides;
+    // A component whose layers' votes disagree with their parities (a tangle scatters the
+    // vertices each layer's vote counts) takes the majority of its votes, a tie its innermost
+    // layer's (the lowest index).
+    for (std::size_t c = 0; c < n; ++c) {
+        int sum = 0, first = 0;
+        bool agree = true, any = false;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (component[i] != c || scene.layer(i).closed) continue;
+            const int vote = sides[i] * parity[i];
+            if (!any) first = vote;
+            agree = agree && vote == first;
+            any = true;
+            sum += vote;
+        }
+        if (!any || agree) continue;
+        const int chosen = sum > 0 ? 1 : sum < 0 ? -1 : first;
+
+        for (std::size_t i = 0; i < n; ++i)
+            if (component[i] == c && !scene.layer(i).closed) sides[i] = chosen * parity[i];
+    }
+    return sides;
+}
 
 void validate(const UntangleParams& params) {
     auto fail = [](const char* field, double value, const char* range) {
@@ -150,7 +231,9 @@ void validate(const UntangleParams& params) {
     validate(params.composition);
 }
 
-UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
+UntangleReport untangle(Scene& scene, const UntangleParams& given, const ProgressFn& progress) {
+    UntangleParams params = given;
+    if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
     return run(scene, whole_scene_pieces(scene), params, progress);
 }
 
@@ -163,7 +246,7 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     InputSides inferred = infer_input_sides(scene);
     UntangleParams with_sides = params;
     with_sides.outside_sides =
-        params.outside_sides.empty() ? outside_sides(scene) : params.outside_sides;
+        params.outside_sides.empty() ? untangling_outside_sides(scene) : params.outside_sides;
     with_sides.input_sides = &inferred;
     if (inferred.rolled_count(scene, with_sides.outside_sides) > 0) {
         Scene rolled = scene;
