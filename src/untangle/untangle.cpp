@@ -48,7 +48,7 @@ std::size_t rolled_kept(const Scene& scene, const InputSides& sides,
 }
 
 UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const UntangleParams& params,
-                   const ProgressFn& progress) {
+                   const ProgressFn& progress, bool keep_simple = false) {
     validate(params);
     validate_sides(scene, params);
     UntangleReport report;
@@ -67,6 +67,7 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         check_params.outside_sides = settings.outside_signs;
         // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
         settings.rest_at_start = true;
+        settings.keep_simple = keep_simple;
         const bool has_sides = params.input_sides && !params.input_sides->empty();
         check_params.input_sides = has_sides ? params.input_sides : nullptr;
         CheckReport check = check_scene(scene, check_params);
@@ -234,7 +235,19 @@ void validate(const UntangleParams& params) {
 UntangleReport untangle(Scene& scene, const UntangleParams& given, const ProgressFn& progress) {
     UntangleParams params = given;
     if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
-    return run(scene, whole_scene_pieces(scene), params, progress);
+    const Scene input = scene;
+    UntangleReport report = run(scene, whole_scene_pieces(scene), params, progress);
+    if (report.collision_free) return report;
+    // Second try, from the input: no vertex move that makes a self-crossing (the projection
+    // and shape matching make them, and nothing takes them out: docs/untangle.md).
+    Scene simple = input;
+    UntangleReport second = run(simple, whole_scene_pieces(simple), params, progress, true);
+    if (!second.collision_free) return report;
+    second.passes += report.passes;
+    second.rounds += report.rounds;
+    second.kept_simple = true;
+    scene = std::move(simple);
+    return second;
 }
 
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,

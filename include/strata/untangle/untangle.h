@@ -129,6 +129,9 @@ struct UntangleReport {
     /// untangle_inferring_sides(): the result kept the sides inferred per region of the input
     /// (infer_input_sides()), which has rolled regions.
     bool inferred_sides = false;
+    /// untangle(): the first try did not come out clean, and the result is the second, from
+    /// the input, in which no vertex move makes a self-crossing (passes and rounds count both).
+    bool kept_simple = false;
 };
 
 /// @brief The outside sides untangle() and untangle_inferring_sides() take when
