@@ -150,6 +150,43 @@ std::vector<Vec2> tangents_along(const Layer& layer, std::size_t count) {
 std::vector<int> untangling_outside_sides(const Scene& scene) {
     std::vector<int> sides = outside_sides(scene);
     const std::size_t n = scene.size();
+    // An open layer directly over a closed one that runs around it (the mean, weighted by
+    // length, of the sine between its segments and the direction from the closed layer's
+    // vertex centroid beyond kAround): outside away from that centroid, whatever the vote.
+    constexpr double kAround = 0.8;
+    for (std::size_t b = 0; b < n; ++b) {
+        const Layer& layer = scene.layer(b);
+        if (layer.closed) continue;
+        for (std::size_t a : scene.inner_of(b)) {
+            const Layer& inner = scene.layer(a);
+            if (!inner.closed) continue;
+            Vec2 centre(0.0);
+            for (const Vec2& p : inner.points) centre += p;
+            centre /= static_cast<double>(inner.points.size());
+            // Only around a body: the centre inside the closed layer (not a band).
+            bool inside = false;
+            for (std::size_t k = 0, m = inner.points.size(); k < m; ++k) {
+                const Vec2 u = inner.points[k], w = inner.points[(k + 1) % m];
+                if ((u.y > centre.y) != (w.y > centre.y) &&
+                    centre.x < u.x + (centre.y - u.y) / (w.y - u.y) * (w.x - u.x))
+                    inside = !inside;
+            }
+            if (!inside) continue;
+            double turn = 0.0, total = 0.0;
+            for (std::size_t k = 0; k + 1 < layer.points.size(); ++k) {
+                const Vec2 d = layer.points[k + 1] - layer.points[k];
+                const Vec2 r = 0.5 * (layer.points[k] + layer.points[k + 1]) - centre;
+                const double rl = glm::length(r);
+                if (!(rl > 0.0)) continue;
+                turn += (r.x * d.y - r.y * d.x) / rl;
+                total += glm::length(d);
+            }
+            if (!(total > 0.0) || std::abs(turn / total) < kAround) continue;
+            // Counter-clockwise around the centre: the outside is on the right (+1).
+            sides[b] = turn > 0.0 ? 1 : -1;
+            break;
+        }
+    }
     // Directly related open layers that run along each other (the mean cosine of their
     // tangents at the same fraction of their lengths beyond +-kParallel): the same outside
     // side when they travel the same way, opposite ones when they travel opposite ways.
@@ -232,22 +269,39 @@ void validate(const UntangleParams& params) {
     validate(params.composition);
 }
 
-UntangleReport untangle(Scene& scene, const UntangleParams& given, const ProgressFn& progress) {
+namespace {
+
+// One untangling of the whole scene, by the outside sides of untangling_outside_sides() unless
+// params gives them; `keep_simple`: EngineSettings::keep_simple.
+UntangleReport untangle_once(Scene& scene, const UntangleParams& given, const ProgressFn& progress,
+                             bool keep_simple) {
     UntangleParams params = given;
     if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
+    UntangleReport report = run(scene, whole_scene_pieces(scene), params, progress, keep_simple);
+    report.kept_simple = keep_simple;
+    return report;
+}
+
+// The second try's report, counting the passes and rounds of the first.
+UntangleReport after(UntangleReport second, const UntangleReport& first) {
+    second.passes += first.passes;
+    second.rounds += first.rounds;
+    return second;
+}
+
+}  // namespace
+
+UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
     const Scene input = scene;
-    UntangleReport report = run(scene, whole_scene_pieces(scene), params, progress);
+    UntangleReport report = untangle_once(scene, params, progress, false);
     if (report.collision_free) return report;
     // Second try, from the input: no vertex move that makes a self-crossing (the projection
     // and shape matching make them, and nothing takes them out: docs/untangle.md).
     Scene simple = input;
-    UntangleReport second = run(simple, whole_scene_pieces(simple), params, progress, true);
+    UntangleReport second = untangle_once(simple, params, progress, true);
     if (!second.collision_free) return report;
-    second.passes += report.passes;
-    second.rounds += report.rounds;
-    second.kept_simple = true;
     scene = std::move(simple);
-    return second;
+    return after(second, report);
 }
 
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
@@ -261,17 +315,46 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     with_sides.outside_sides =
         params.outside_sides.empty() ? untangling_outside_sides(scene) : params.outside_sides;
     with_sides.input_sides = &inferred;
-    if (inferred.rolled_count(scene, with_sides.outside_sides) > 0) {
-        Scene rolled = scene;
-        UntangleReport report = untangle(rolled, with_sides, progress);
+    const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
+    // By the inferred sides, then by the global order; the second tries (no self-crossing
+    // made) only when neither first try is clean, so that a scene one of them cleans costs
+    // what it did without them.
+    const Scene input = scene;
+    UntangleReport first;  // the global order's first try: the result when nothing is clean
+    Scene first_scene;
+    int passes = 0, rounds = 0;
+    for (bool keep_simple : {false, true}) {
+        if (rolled) {
+            Scene attempt = input;
+            UntangleReport report = untangle_once(attempt, with_sides, progress, keep_simple);
+            passes += report.passes;
+            rounds += report.rounds;
+            if (report.collision_free) {
+                report.inferred_sides = true;
+                report.passes = passes;
+                report.rounds = rounds;
+                scene = std::move(attempt);
+                if (kept) *kept = std::move(inferred);
+                return report;
+            }
+        }
+        Scene attempt = input;
+        UntangleReport report = untangle_once(attempt, params, progress, keep_simple);
+        passes += report.passes;
+        rounds += report.rounds;
         if (report.collision_free) {
-            report.inferred_sides = true;
-            scene = std::move(rolled);
-            if (kept) *kept = std::move(inferred);
+            report.passes = passes;
+            report.rounds = rounds;
+            scene = std::move(attempt);
             return report;
         }
+        if (!keep_simple) {
+            first = report;
+            first_scene = std::move(attempt);
+        }
     }
-    return untangle(scene, params, progress);
+    scene = std::move(first_scene);
+    return first;
 }
 
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,

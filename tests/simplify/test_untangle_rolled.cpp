@@ -401,6 +401,31 @@ TEST_CASE("untangling_outside_sides: a tangled stack's outside sides as the orig
     CHECK(split_votes > 0);  // what the test is about: some decimation splits the votes
 }
 
+TEST_CASE("untangling_outside_sides: an open jacket around a tangled body faces away from it",
+          "[untangle][sides]") {
+    // An open jacket over a closed body, 95% removed at random, seed 6: more of the body's
+    // vertices end up outside the jacket than inside, and the jacket's vote turns its outside
+    // toward the body (untangled against it, the jacket came out inside out: 8 nesting
+    // violations by the original's sides). It runs around the body's centre, counter-clockwise:
+    // its outside is away from it.
+    FamilyParams p;
+    p.layers = 6;
+    const Scene input = make_scene(SceneFamily::Jacket, p);
+    const std::vector<int> original = outside_sides(input);
+    const Scene tangled = naive_decimation(input, 0.95, 6);
+    REQUIRE(check_scene(tangled).crossing_count > 0);
+    CHECK(outside_sides(tangled) != original);  // the vote that failed
+    REQUIRE(untangling_outside_sides(tangled) == original);
+    Scene out = tangled;
+    CHECK(untangle(out, UntangleParams{}).collision_free);
+    CheckParams judged;
+    judged.outside_sides = original;
+    judged.separation_tolerance = 0.1;
+    const CheckReport c = check_scene(out, judged);
+    CHECK(c.is_collision_free());
+    CHECK(c.separations_hold());
+}
+
 TEST_CASE("untangle's second try makes no self-crossing: the S-folded stack at 95%", "[untangle]") {
     // 4 layers folded over themselves, 95% removed at random (strata_bench_untangle's "folded
     // naive95" is seed 1): the first untangling wanders for 64 passes and leaves crossings and

@@ -136,7 +136,11 @@ struct UntangleReport {
 
 /// @brief The outside sides untangle() and untangle_inferring_sides() take when
 /// params.outside_sides is empty (`strata untangle` judges its result by them too):
-/// outside_side() of every layer, made consistent where a tangle split the votes. Two directly
+/// outside_side() of every layer, made consistent where a tangle split the votes. An open
+/// layer directly over a closed one whose vertex centroid lies inside it, and that runs around
+/// that centroid (the mean over its segments, weighted by length, of the sine between the
+/// segment and the direction from the centroid beyond 0.8 either way), faces away from it (+1
+/// counter-clockwise), whatever its vote (a tangled body's vertices can outvote it). Two directly
 /// related open layers that run along each other (the mean cosine of their tangents at 64
 /// evenly spaced fractions of their lengths beyond 0.8 either way) must have the same outside
 /// side when they travel the same way and opposite ones otherwise. Where the votes of a chain
