@@ -236,7 +236,6 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
         }
         if (!any || agree) continue;
         const int chosen = sum > 0 ? 1 : sum < 0 ? -1 : first;
-
         for (std::size_t i = 0; i < n; ++i)
             if (component[i] == c && !scene.layer(i).closed) sides[i] = chosen * parity[i];
     }
