@@ -199,7 +199,7 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
     }
     const double seconds = now() - start;
     if (how == "real" && report.inferred_sides) {  // judged as untangle judged it
-        scoring.outside_sides = outside_sides(tangled);
+        scoring.outside_sides = untangling_outside_sides(tangled);
         scoring.input_sides = &inferred;
     }
     const CheckReport after = check_scene(scene, scoring);

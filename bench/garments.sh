@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Slices every garment of ../shared/data/garments with its body at regular heights, runs
-# `strata check` on every slice, then `strata simplify` on every slice at 90% removal (a batch:
-# slices whose input already crosses are untangled first, or fail with the reason when that
-# cannot be done, e.g. a layer that crosses itself); prints one summary row per outfit for each
-# stage, and writes one HTML gallery per outfit (OUT_DIR/NAME.html: a tile per slice, the input
-# faint under the result, crossings ringed in red; bench/gallery.py).
+# `strata check` on every slice, then `strata simplify` on every slice at 90% removal (or
+# REMOVAL; a batch: slices whose input already crosses are untangled first, or fail with the
+# reason when that cannot be done, e.g. a layer that crosses itself); prints one summary row per
+# outfit for each stage, and writes one HTML gallery per outfit (OUT_DIR/NAME.html: a tile per
+# slice, the input faint under the result, crossings ringed in red; bench/gallery.py).
 #
-#   bench/garments.sh [OUT_DIR]          (from the repository root, after building strata_cli)
+#   bench/garments.sh [OUT_DIR [REMOVAL]]   (from the repository root, after building strata_cli)
 #
 # MakeHuman outfits (decimetres): body + suit, every 0.5 dm over their height, --order body,suit.
 # Codim-IPC skirt (metres): split into components, every 0.05 m (the same 0.5 dm).
@@ -16,6 +16,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 strata=${STRATA:-$root/build/tools/strata}
 data=${DATA:-$root/../shared/data/garments}
 out=${1:-$root/build/bench/garments}
+removal=${2:-0.9}
 [ -x "$strata" ] || { echo "garments.sh: no strata binary at $strata (build strata_cli)" >&2; exit 2; }
 # 77: skipped (CTest's SKIP_RETURN_CODE) when the shared garments are not beside the project.
 [ -d "$data" ] || { echo "garments.sh: no garments folder at $data (skipped)" >&2; exit 77; }
@@ -51,16 +52,16 @@ slice_outfit() {
   done
   rows+=("$(printf '%-20s %6d %7d %9d %7d %7d %10d %9d %6ds' "$name" "$slices" "$layers" "$vertices" "$links" \
             "$welded" "$crossing" "$nesting" $((SECONDS - t0)))")
-  # Simplify the whole folder at 90% removal (batch, parallel over slices).
+  # Simplify the whole folder at $removal (batch, parallel over slices).
   t0=$SECONDS
   rm -rf "${out:?}/$name-simplified"
-  "$strata" simplify "$out/$name" -o "$out/$name-simplified" --remove 0.9 --compare-naive \
+  "$strata" simplify "$out/$name" -o "$out/$name-simplified" --remove "$removal" --compare-naive \
     --report "$out/$name.simplify.json" > "$out/$name.simplify.log" 2> "$out/$name.simplify.err" || true
   local seconds=$((SECONDS - t0)) gaps
   # Smallest gap after / gap before over the near pairs of every simplified slice.
   gaps=$(python3 "$root/bench/gap_ratios.py" "$out/$name" "$out/$name-simplified" | tee "$out/$name.gaps.log" |
          sed -nE 's/^smallest ratio ([0-9.inf]+); pairs below 0.9: ([0-9]+).*/\1 \2/p')
-  python3 "$root/bench/gallery.py" --title "$name: strata simplify --remove 0.9" --strata "$strata" \
+  python3 "$root/bench/gallery.py" --title "$name: strata simplify --remove $removal" --strata "$strata" \
     --report "$out/$name.simplify.json" --out "$out/$name.html" > /dev/null
   srows+=("$(python3 - "$out/$name.simplify.json" "$name" "$seconds" $gaps <<'PY'
 import json, sys
@@ -77,8 +78,12 @@ tangled = sum(1 for r in ok if not r["collision_free"])
 # were untangled first are counted apart ("after-untangle"): see the README, Real garments.
 broken = sum(1 for r in ok if not r["collision_free"] and "input_untangled" not in r)
 over = sum(1 for r in ok for l in r["layers"] if l["after"] > 1.05 * l["target"] and l["after"] > 3)
-print("%-20s %6d %9d %6d %9d %8d %9d %8d %8d %8d %8d %9s %5d %6ss %d" % (sys.argv[2], len(runs), untangled,
-      len(runs) - len(ok), before, after, naive, strata, tangled, refused, over, sys.argv[4], int(sys.argv[5]),
+# The issue's budget: a slice's vertices within 5% of the sum of its layers' targets (which hold
+# the floor of 3 vertices of a closed layer).
+over_slices = sum(1 for r in ok if sum(l["after"] for l in r["layers"]) >
+                  1.05 * sum(l["target"] for l in r["layers"]))
+print("%-20s %6d %9d %6d %9d %8d %9d %8d %8d %8d %8d %8d %9s %5d %6ss %d" % (sys.argv[2], len(runs), untangled,
+      len(runs) - len(ok), before, after, naive, strata, tangled, refused, over_slices, over, sys.argv[4], int(sys.argv[5]),
       sys.argv[3], broken))
 PY
 )")
@@ -98,12 +103,13 @@ echo "(strata check: crossings or self-crossings > 0)"
 echo "nest-viol: crossing-free slices whose inferred nesting strata check rejects"
 echo "slices in $out"
 echo
-printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %8s %9s %5s %7s %s\n' outfit slices untangled failed vertices \
-  after "naive-x" "strata-x" tangled refused "over-5%" "gap-ratio" "<0.9" time bad
+printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %8s %8s %9s %5s %7s %s\n' outfit slices untangled failed vertices \
+  after "naive-x" "strata-x" tangled refused "sl-5%" "over-5%" "gap-ratio" "<0.9" time bad
 for r in "${srows[@]}"; do echo "$r"; done
 echo "untangled: inputs that crossed, untangled before simplifying; failed: not simplified (the"
 echo "reason is in the .simplify.json: e.g. a layer that crosses itself cannot be untangled);"
 echo "naive-x / strata-x: crossings after naive decimation / after strata; tangled: outputs not collision-free;"
+echo "sl-5%: slices whose vertices exceed the sum of their layers' targets by more than 5%;"
 echo "over-5%: layers (of more than 3 vertices) kept more than 5% above their target;"
 echo "gap-ratio: smallest gap after / gap before over the near pairs that do not cross in the input (bench/gap_ratios.py); <0.9: pairs below 0.9;"
 echo "bad: of those, outputs of inputs that were collision-free as read (the guarantee)"

@@ -105,13 +105,13 @@ Run add_untangle_command(CLI::App& app) {
             params.input_sides = &reference->sides;  // untangling keeps the vertex indices
         } else if (opt->infer_sides) {
             inferred = infer_input_sides(input);
-            params.outside_sides = outside_sides(input);
+            params.outside_sides = untangling_outside_sides(input);
             params.input_sides = &inferred;
         }
         // Judged as untangle() judges: by the outside sides it untangles toward (the input's
         // when none are given), not by a fresh vote on the result.
         check_params.outside_sides =
-            params.outside_sides.empty() ? outside_sides(input) : params.outside_sides;
+            params.outside_sides.empty() ? untangling_outside_sides(input) : params.outside_sides;
         check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();

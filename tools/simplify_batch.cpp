@@ -144,7 +144,7 @@ Scene untangle_input(const Scene& start, const UntangleParams& u, InputUntanglin
     info.report = untangle_inferring_sides(scene, u, {}, &inferred);
     CheckParams check_params;
     if (info.report.inferred_sides) {
-        check_params.outside_sides = outside_sides(start);
+        check_params.outside_sides = untangling_outside_sides(start);
         check_params.input_sides = &inferred;  // untangling keeps the vertex indices
     }
     after = check_scene(scene, check_params);

@@ -4,12 +4,13 @@
 #include "strata/core/format.h"
 #include "strata/io/atomic_file.h"
 
+#include <simdjson.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <charconv>
+#include <cmath>
+#include <limits>
 #include <map>
-#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -289,188 +290,129 @@ class SceneSax {
     std::string capture_key_;
 };
 
-// The common case read directly from the text, before either reader: a scene whose keys are
-// all ones strata knows, strings without escapes or non-ASCII bytes, numbers by std::from_chars
-// (correctly rounded, as nlohmann's strtod; an integer token goes through a 64-bit integer as
-// nlohmann reads it, so "-0" stays +0). Anything else (unknown keys, a duplicate key, an
-// escape, a syntax or type error, a number out of range) makes it give up and the readers
-// above take the text: what it reads is what they read, at a fraction of the cost.
+// The common scene read by simdjson's DOM parser (which picks the CPU's SIMD kernels at run
+// time), before the readers below: every key one strata knows, numbers and strings as
+// nlohmann reads them (an integer token as a 64-bit integer, so "-0" is +0; strings
+// unescaped). Anything else (an unknown key, whose value must be kept as written; a duplicate
+// key; a syntax or type error; a number out of range) makes read() return false, and the
+// readers below take the text and name what is wrong.
 class FastScene {
   public:
-    explicit FastScene(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {}
-
-    bool read() {
-        if (!object([&](std::string_view key) {
-                if (key == "strata") {
-                    double v = 0.0;
-                    bool integer = false;
-                    return number(v, &integer) && integer && v == 1.0;
-                }
-                if (key == "units") return string(units);
-                if (key == "layers") {
-                    has_layers = true;
-                    return array([&] { return layer(); });
-                }
-                return false;
-            }))
+    // `text` followed by `capacity` - text.size() readable bytes: simdjson reads up to
+    // SIMDJSON_PADDING bytes past the end, and copies a text without that room.
+    bool read(std::string_view text, std::size_t capacity) {
+        simdjson::dom::parser parser;
+        simdjson::dom::element root;
+        const bool parsed =
+            capacity >= text.size() + simdjson::SIMDJSON_PADDING
+                ? !parser.parse(simdjson::padded_string_view(text.data(), text.size(), capacity))
+                       .get(root)
+                : !parser.parse(text.data(), text.size()).get(root);
+        if (!parsed) return false;
+        bool has_layers = false;
+        const bool read = fields(root, [&](std::string_view key, simdjson::dom::element v) {
+            if (key == "strata") {
+                const auto type = v.type();
+                return (type == simdjson::dom::element_type::INT64 ||
+                        type == simdjson::dom::element_type::UINT64) &&
+                       number(v) == 1.0;
+            }
+            if (key == "units") return string(v, units);
+            if (key == "layers") {
+                has_layers = true;
+                return items(v, [&](simdjson::dom::element item) { return layer(item); });
+            }
             return false;
-        space();
-        return p_ == end_ && has_layers && !layers.empty();
+        });
+        return read && has_layers && !layers.empty();
     }
 
-    bool has_layers = false;
     std::string units;
     std::vector<Layer> layers;
 
   private:
-    void space() {
-        while (p_ != end_ && (*p_ == ' ' || *p_ == '\n' || *p_ == '\r' || *p_ == '\t')) ++p_;
+    // The number `v` as a double (NaN when it is not a number, which no JSON number reads as).
+    static double number(simdjson::dom::element v) {
+        switch (v.type()) {
+            case simdjson::dom::element_type::INT64:
+                return static_cast<double>(v.get_int64().value_unsafe());
+            case simdjson::dom::element_type::UINT64:
+                return static_cast<double>(v.get_uint64().value_unsafe());
+            case simdjson::dom::element_type::DOUBLE:
+                return v.get_double().value_unsafe();
+            default:
+                return std::numeric_limits<double>::quiet_NaN();
+        }
     }
-    bool take(char c) {
-        space();
-        if (p_ == end_ || *p_ != c) return false;
-        ++p_;
+    static bool number(simdjson::dom::element v, double& out) {
+        out = number(v);
+        return !std::isnan(out);
+    }
+    static bool string(simdjson::dom::element v, std::string& out) {
+        std::string_view s;
+        if (v.get_string().get(s)) return false;
+        out.assign(s);
         return true;
     }
-    bool peek(char c) {
-        space();
-        return p_ != end_ && *p_ == c;
-    }
-    bool literal(std::string_view word) {
-        space();
-        if (static_cast<std::size_t>(end_ - p_) < word.size() ||
-            std::string_view(p_, word.size()) != word)
-            return false;
-        p_ += word.size();
-        return true;
-    }
-    // A string of printable ASCII without escapes.
-    bool string(std::string& out) {
-        if (!take('"')) return false;
-        const char* first = p_;
-        while (p_ != end_ && *p_ != '"') {
-            const unsigned char c = static_cast<unsigned char>(*p_);
-            if (c < 0x20 || c >= 0x80 || c == '\\') return false;
-            ++p_;
-        }
-        if (p_ == end_) return false;
-        out.assign(first, p_);
-        ++p_;
-        return true;
-    }
-    // A JSON number (its grammar checked here: from_chars accepts more).
-    bool number(double& out, bool* integer = nullptr) {
-        space();
-        const char* first = p_;
-        const char* q = p_;
-        if (q != end_ && *q == '-') ++q;
-        if (q == end_ || *q < '0' || *q > '9') return false;
-        if (*q == '0')
-            ++q;
-        else
-            while (q != end_ && *q >= '0' && *q <= '9') ++q;
-        bool whole = true;
-        if (q != end_ && *q == '.') {
-            whole = false;
-            ++q;
-            if (q == end_ || *q < '0' || *q > '9') return false;
-            while (q != end_ && *q >= '0' && *q <= '9') ++q;
-        }
-        if (q != end_ && (*q == 'e' || *q == 'E')) {
-            whole = false;
-            ++q;
-            if (q != end_ && (*q == '+' || *q == '-')) ++q;
-            if (q == end_ || *q < '0' || *q > '9') return false;
-            while (q != end_ && *q >= '0' && *q <= '9') ++q;
-        }
-        p_ = q;
-        if (integer) *integer = whole;
-        if (whole) {
-            if (*first == '-') {
-                long long v = 0;
-                const auto r = std::from_chars(first, q, v);
-                if (r.ec == std::errc() && r.ptr == q) {
-                    out = static_cast<double>(v);
-                    return true;
-                }
-            } else {
-                unsigned long long v = 0;
-                const auto r = std::from_chars(first, q, v);
-                if (r.ec == std::errc() && r.ptr == q) {
-                    out = static_cast<double>(v);
-                    return true;
-                }
-            }
-            if (integer) *integer = false;  // nlohmann reads it as a float
-        }
-        const auto r = std::from_chars(first, q, out);
-        return r.ec == std::errc() && r.ptr == q;
-    }
+    // Calls item(element) for each element of the array `v`; false when `v` is not an array or
+    // an item() fails.
     template <class Item>
-    bool array(Item&& item) {
-        if (!take('[')) return false;
-        if (take(']')) return true;
-        do {
-            if (!item()) return false;
-        } while (take(','));
-        return take(']');
+    static bool items(simdjson::dom::element v, Item&& item) {
+        simdjson::dom::array array;
+        if (v.get_array().get(array)) return false;
+        for (simdjson::dom::element element : array)
+            if (!item(element)) return false;
+        return true;
     }
-    // An object without duplicate keys; value(key) reads the value of each.
+    // Calls value(key, element) for each field of the object `v`; false when `v` is not an
+    // object, on a duplicate key, or when a value() fails.
     template <class Value>
-    bool object(Value&& value) {
-        if (!take('{')) return false;
-        if (take('}')) return true;
-        std::vector<std::string> seen;
-        std::string key;
-        do {
-            if (!string(key) || !take(':')) return false;
-            if (std::find(seen.begin(), seen.end(), key) != seen.end()) return false;
-            seen.push_back(key);
-            if (!value(std::string_view(key))) return false;
-        } while (take(','));
-        return take('}');
+    static bool fields(simdjson::dom::element v, Value&& value) {
+        simdjson::dom::object object;
+        if (v.get_object().get(object)) return false;
+        std::vector<std::string_view> seen;
+        for (const simdjson::dom::key_value_pair field : object) {
+            if (std::find(seen.begin(), seen.end(), field.key) != seen.end()) return false;
+            seen.push_back(field.key);
+            if (!value(field.key, field.value)) return false;
+        }
+        return true;
     }
-    bool layer() {
-        layers.emplace_back();
-        Layer& l = layers.back();
+    bool layer(simdjson::dom::element v) {
+        Layer& l = layers.emplace_back();
         l.name = "layer_" + std::to_string(layers.size() - 1);
         bool has_points = false;
-        const bool read = object([&](std::string_view key) {
-            if (key == "name") return string(l.name);
-            if (key == "closed") {
-                if (literal("true")) {
-                    l.closed = true;
-                    return true;
-                }
-                l.closed = false;
-                return literal("false");
-            }
-            if (key == "thickness") return number(l.thickness);
-            if (key == "weight") return number(l.weight);
+        const bool read = fields(v, [&](std::string_view key, simdjson::dom::element x) {
+            if (key == "name") return string(x, l.name);
+            if (key == "closed") return !x.get_bool().get(l.closed);
+            if (key == "thickness") return number(x, l.thickness);
+            if (key == "weight") return number(x, l.weight);
             if (key == "alpha" || key == "beta") {
-                std::optional<double>& v = key == "alpha" ? l.alpha : l.beta;
-                if (literal("null")) return true;
-                double x = 0.0;
-                if (!number(x)) return false;
-                v = x;
+                if (x.is_null()) return true;
+                double a = 0.0;
+                if (!number(x, a)) return false;
+                (key == "alpha" ? l.alpha : l.beta) = a;
                 return true;
             }
             if (key == "outer") {
                 l.outer.emplace();
-                return array([&] {
-                    std::string name;
-                    if (!string(name)) return false;
-                    l.outer->push_back(std::move(name));
-                    return true;
+                return items(x, [&](simdjson::dom::element name) {
+                    return string(name, l.outer->emplace_back());
                 });
             }
             if (key == "points") {
                 has_points = true;
-                return array([&] {
-                    double x = 0.0, y = 0.0;
-                    if (!take('[') || !number(x) || !take(',') || !number(y) || !take(']'))
+                simdjson::dom::array points;
+                if (x.get_array().get(points)) return false;
+                l.points.reserve(points.size());
+                return items(x, [&](simdjson::dom::element point) {
+                    simdjson::dom::array xy;
+                    double px = 0.0, py = 0.0;
+                    if (point.get_array().get(xy) || xy.size() != 2 ||
+                        !number(xy.at(0).value_unsafe(), px) ||
+                        !number(xy.at(1).value_unsafe(), py))
                         return false;
-                    l.points.emplace_back(x, y);
+                    l.points.emplace_back(px, py);
                     return true;
                 });
             }
@@ -478,9 +420,6 @@ class FastScene {
         });
         return read && has_points;
     }
-
-    const char* p_;
-    const char* end_;
 };
 
 class Reader {
@@ -558,9 +497,10 @@ class Reader {
         return layer;
     }
 
-    Scene scene(std::string_view text) const {
-        // The direct reader nests 4 levels at most: no depth check before it.
-        if (FastScene fast(text); fast.read())
+    // `capacity`: FastScene::read().
+    Scene scene(std::string_view text, std::size_t capacity = 0) const {
+        // FastScene takes 4 levels of nesting at most: no depth scan before it.
+        if (FastScene fast; fast.read(text, capacity))
             return finish(std::move(fast.layers), fast.units, {});
         if (const std::size_t deep = too_deep_at(text); deep != std::string_view::npos) {
             const auto [line, column] = line_column(text, deep);
@@ -715,7 +655,8 @@ std::string scene_to_json(const Scene& scene) {
 }
 
 Scene read_scene_json(const std::filesystem::path& path) {
-    return parse_scene_json(read_text_file(path), path.string());
+    const std::string text = read_text_file(path);  // with room to spare: read_text_file()
+    return Reader(path.string()).scene(text, text.capacity());
 }
 
 void write_scene_json(const Scene& scene, const std::filesystem::path& path) {

@@ -48,7 +48,7 @@ std::size_t rolled_kept(const Scene& scene, const InputSides& sides,
 }
 
 UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const UntangleParams& params,
-                   const ProgressFn& progress) {
+                   const ProgressFn& progress, bool keep_simple = false) {
     validate(params);
     validate_sides(scene, params);
     UntangleReport report;
@@ -67,6 +67,7 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         check_params.outside_sides = settings.outside_signs;
         // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
         settings.rest_at_start = true;
+        settings.keep_simple = keep_simple;
         const bool has_sides = params.input_sides && !params.input_sides->empty();
         check_params.input_sides = has_sides ? params.input_sides : nullptr;
         CheckReport check = check_scene(scene, check_params);
@@ -122,7 +123,124 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
     return report;
 }
 
+// Unit tangents of open `layer` at `count` points evenly spaced along its length.
+std::vector<Vec2> tangents_along(const Layer& layer, std::size_t count) {
+    std::vector<Vec2> out;
+    const double total = layer.length();
+    if (!(total > 0.0)) return out;
+    std::size_t segment = 0;
+    double before = 0.0;  // length of the segments before `segment`
+    for (std::size_t k = 0; k < count; ++k) {
+        const double at = (static_cast<double>(k) + 0.5) / static_cast<double>(count) * total;
+        while (segment + 1 < layer.segment_count() &&
+               before + glm::distance(layer.segment_start(segment), layer.segment_end(segment)) <
+                   at) {
+            before += glm::distance(layer.segment_start(segment), layer.segment_end(segment));
+            ++segment;
+        }
+        const Vec2 d = layer.segment_end(segment) - layer.segment_start(segment);
+        const double len = glm::length(d);
+        out.push_back(len > 0.0 ? d / len : Vec2(0.0));
+    }
+    return out;
+}
+
 }  // namespace
+
+std::vector<int> untangling_outside_sides(const Scene& scene) {
+    std::vector<int> sides = outside_sides(scene);
+    const std::size_t n = scene.size();
+    // An open layer directly over a closed one that runs around it (the mean, weighted by
+    // length, of the sine between its segments and the direction from the closed layer's
+    // vertex centroid beyond kAround): outside away from that centroid, whatever the vote.
+    constexpr double kAround = 0.8;
+    for (std::size_t b = 0; b < n; ++b) {
+        const Layer& layer = scene.layer(b);
+        if (layer.closed) continue;
+        for (std::size_t a : scene.inner_of(b)) {
+            const Layer& inner = scene.layer(a);
+            if (!inner.closed) continue;
+            Vec2 centre(0.0);
+            for (const Vec2& p : inner.points) centre += p;
+            centre /= static_cast<double>(inner.points.size());
+            // Only around a body: the centre inside the closed layer (not a band).
+            bool inside = false;
+            for (std::size_t k = 0, m = inner.points.size(); k < m; ++k) {
+                const Vec2 u = inner.points[k], w = inner.points[(k + 1) % m];
+                if ((u.y > centre.y) != (w.y > centre.y) &&
+                    centre.x < u.x + (centre.y - u.y) / (w.y - u.y) * (w.x - u.x))
+                    inside = !inside;
+            }
+            if (!inside) continue;
+            double turn = 0.0, total = 0.0;
+            for (std::size_t k = 0; k + 1 < layer.points.size(); ++k) {
+                const Vec2 d = layer.points[k + 1] - layer.points[k];
+                const Vec2 r = 0.5 * (layer.points[k] + layer.points[k + 1]) - centre;
+                const double rl = glm::length(r);
+                if (!(rl > 0.0)) continue;
+                turn += (r.x * d.y - r.y * d.x) / rl;
+                total += glm::length(d);
+            }
+            if (!(total > 0.0) || std::abs(turn / total) < kAround) continue;
+            // Counter-clockwise around the centre: the outside is on the right (+1).
+            sides[b] = turn > 0.0 ? 1 : -1;
+            break;
+        }
+    }
+    // Directly related open layers that run along each other (the mean cosine of their
+    // tangents at the same fraction of their lengths beyond +-kParallel): the same outside
+    // side when they travel the same way, opposite ones when they travel opposite ways.
+    constexpr std::size_t kSamples = 64;
+    constexpr double kParallel = 0.8;
+    std::vector<std::vector<Vec2>> tangents(n);
+    for (std::size_t i = 0; i < n; ++i)
+        if (!scene.layer(i).closed) tangents[i] = tangents_along(scene.layer(i), kSamples);
+    // Components of such pairs, with each layer's parity to its component's first layer.
+    std::vector<std::size_t> component(n);
+    std::vector<int> parity(n, 1);
+    for (std::size_t i = 0; i < n; ++i) component[i] = i;
+    bool linked = false;
+    for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b : scene.outer_of(a)) {
+            if (tangents[a].size() != kSamples || tangents[b].size() != kSamples) continue;
+            double cosine = 0.0;
+            for (std::size_t k = 0; k < kSamples; ++k)
+                cosine += glm::dot(tangents[a][k], tangents[b][k]);
+            cosine /= static_cast<double>(kSamples);
+            if (std::abs(cosine) < kParallel) continue;
+            const int together = cosine > 0.0 ? 1 : -1;
+            const std::size_t ca = component[a], cb = component[b];
+            if (ca == cb) continue;  // the first link found decides
+            const int flip = parity[a] * parity[b] * together;
+            for (std::size_t i = 0; i < n; ++i)
+                if (component[i] == cb) {
+                    component[i] = ca;
+                    parity[i] *= flip;
+                }
+            linked = true;
+        }
+    if (!linked) return sides;
+    // A component whose layers' votes disagree with their parities (a tangle scatters the
+    // vertices each layer's vote counts) takes the majority of its votes, a tie its innermost
+    // layer's (the lowest index).
+    for (std::size_t c = 0; c < n; ++c) {
+        int sum = 0, first = 0;
+        bool agree = true, any = false;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (component[i] != c || scene.layer(i).closed) continue;
+            const int vote = sides[i] * parity[i];
+            if (!any) first = vote;
+            agree = agree && vote == first;
+            any = true;
+            sum += vote;
+        }
+        if (!any || agree) continue;
+        const int chosen = sum > 0 ? 1 : sum < 0 ? -1 : first;
+        for (std::size_t i = 0; i < n; ++i)
+            if (component[i] == c && !scene.layer(i).closed) sides[i] = chosen * parity[i];
+    }
+    return sides;
+}
 
 void validate(const UntangleParams& params) {
     auto fail = [](const char* field, double value, const char* range) {
@@ -150,8 +268,39 @@ void validate(const UntangleParams& params) {
     validate(params.composition);
 }
 
+namespace {
+
+// One untangling of the whole scene, by the outside sides of untangling_outside_sides() unless
+// params gives them; `keep_simple`: EngineSettings::keep_simple.
+UntangleReport untangle_once(Scene& scene, const UntangleParams& given, const ProgressFn& progress,
+                             bool keep_simple) {
+    UntangleParams params = given;
+    if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
+    UntangleReport report = run(scene, whole_scene_pieces(scene), params, progress, keep_simple);
+    report.kept_simple = keep_simple;
+    return report;
+}
+
+// The second try's report, counting the passes and rounds of the first.
+UntangleReport after(UntangleReport second, const UntangleReport& first) {
+    second.passes += first.passes;
+    second.rounds += first.rounds;
+    return second;
+}
+
+}  // namespace
+
 UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
-    return run(scene, whole_scene_pieces(scene), params, progress);
+    const Scene input = scene;
+    UntangleReport report = untangle_once(scene, params, progress, false);
+    if (report.collision_free) return report;
+    // Second try, from the input: no vertex move that makes a self-crossing (the projection
+    // and shape matching make them, and nothing takes them out: docs/untangle.md).
+    Scene simple = input;
+    UntangleReport second = untangle_once(simple, params, progress, true);
+    if (!second.collision_free) return report;
+    scene = std::move(simple);
+    return after(second, report);
 }
 
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
@@ -163,19 +312,48 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     InputSides inferred = infer_input_sides(scene);
     UntangleParams with_sides = params;
     with_sides.outside_sides =
-        params.outside_sides.empty() ? outside_sides(scene) : params.outside_sides;
+        params.outside_sides.empty() ? untangling_outside_sides(scene) : params.outside_sides;
     with_sides.input_sides = &inferred;
-    if (inferred.rolled_count(scene, with_sides.outside_sides) > 0) {
-        Scene rolled = scene;
-        UntangleReport report = untangle(rolled, with_sides, progress);
+    const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
+    // By the inferred sides, then by the global order; the second tries (no self-crossing
+    // made) only when neither first try is clean, so that a scene one of them cleans costs
+    // what it did without them.
+    const Scene input = scene;
+    UntangleReport first;  // the global order's first try: the result when nothing is clean
+    Scene first_scene;
+    int passes = 0, rounds = 0;
+    for (bool keep_simple : {false, true}) {
+        if (rolled) {
+            Scene attempt = input;
+            UntangleReport report = untangle_once(attempt, with_sides, progress, keep_simple);
+            passes += report.passes;
+            rounds += report.rounds;
+            if (report.collision_free) {
+                report.inferred_sides = true;
+                report.passes = passes;
+                report.rounds = rounds;
+                scene = std::move(attempt);
+                if (kept) *kept = std::move(inferred);
+                return report;
+            }
+        }
+        Scene attempt = input;
+        UntangleReport report = untangle_once(attempt, params, progress, keep_simple);
+        passes += report.passes;
+        rounds += report.rounds;
         if (report.collision_free) {
-            report.inferred_sides = true;
-            scene = std::move(rolled);
-            if (kept) *kept = std::move(inferred);
+            report.passes = passes;
+            report.rounds = rounds;
+            scene = std::move(attempt);
             return report;
         }
+        if (!keep_simple) {
+            first = report;
+            first_scene = std::move(attempt);
+        }
     }
-    return untangle(scene, params, progress);
+    scene = std::move(first_scene);
+    return first;
 }
 
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,

@@ -129,7 +129,28 @@ struct UntangleReport {
     /// untangle_inferring_sides(): the result kept the sides inferred per region of the input
     /// (infer_input_sides()), which has rolled regions.
     bool inferred_sides = false;
+    /// untangle(): the first try did not come out clean, and the result is the second, from
+    /// the input, in which no vertex move makes a self-crossing (passes and rounds count both).
+    bool kept_simple = false;
 };
+
+/// @brief The outside sides untangle() and untangle_inferring_sides() take when
+/// params.outside_sides is empty (`strata untangle` judges its result by them too):
+/// outside_side() of every layer, made consistent where a tangle split the votes. An open
+/// layer directly over a closed one whose vertex centroid lies inside it, and that runs around
+/// that centroid (the mean over its segments, weighted by length, of the sine between the
+/// segment and the direction from the centroid beyond 0.8 either way), faces away from it (+1
+/// counter-clockwise), whatever its vote (a tangled body's vertices can outvote it). Two directly
+/// related open layers that run along each other (the mean cosine of their tangents at 64
+/// evenly spaced fractions of their lengths beyond 0.8 either way) must have the same outside
+/// side when they travel the same way and opposite ones otherwise. Where the votes of a chain
+/// of such layers disagree (in a scene tangled by decimation, a layer's vote counts the
+/// neighbours' vertices scattered on both sides of it), every layer of the chain takes the
+/// majority of the chain's votes (a tie: its lowest-index layer's). Where they agree (an
+/// untangled scene), they are returned as they are. Layers with a rolled part run along each
+/// other less (0.38-0.65 on strata_bench_untangle's rolled families) and are left to their
+/// own votes. docs/untangle.md, "Outside sides of a tangled scene".
+std::vector<int> untangling_outside_sides(const Scene& scene);
 
 /// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
 /// global order, except where params.input_sides gives a vertex another side.

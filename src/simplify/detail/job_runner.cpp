@@ -115,10 +115,16 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
             for (std::size_t v = 0; v < live_.layer(k).alive.size(); ++v)
                 if (live_.layer(k).alive[v]) mark(k, v, marked[k], waiting);
     } else {
-        live_.segments_near(around, [&](std::size_t k, std::size_t u) {
-            mark(k, u, marked[k], waiting);
-            mark(k, live_.layer(k).next[u], marked[k], waiting);
-        });
+        // The segments filed in the cells of the input's grid that `around` touches (those
+        // the live grid gave before it was built again for longer segments): the region is
+        // the same at any later cell size.
+        const LivePolylines::CellRange cells = live_.input_cells(around);
+        live_.segments_near(around.inflated(2.0 * live_.input_cell()),
+                            [&](std::size_t k, std::size_t u) {
+                                if (!cells.meets(live_.input_cells(live_.seg_box(k, u)))) return;
+                                mark(k, u, marked[k], waiting);
+                                mark(k, live_.layer(k).next[u], marked[k], waiting);
+                            });
     }
     job.runs.clear();
     for (std::size_t k = 0; k < live_.size() && !conflict_; ++k)

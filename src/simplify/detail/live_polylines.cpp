@@ -12,7 +12,6 @@ LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>&
     : grid_(make_segment_grid(1.0)) {
     const std::size_t n = scene.size();
     layers_.resize(n);
-    std::vector<double> lengths;
     for (std::size_t l = 0; l < n; ++l) {
         const Layer& in = scene.layer(l);
         WorkLayer& w = layers_[l];
@@ -29,23 +28,35 @@ LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>&
         w.locked.assign(m, 0);
         w.alive_count = m;
         w.target = targets[l];
-        for (std::size_t i = 0; i < in.segment_count(); ++i)
-            lengths.push_back(glm::distance(in.segment_start(i), in.segment_end(i)));
     }
-    // Cells of 4 median segment lengths.
+    bounds_ = scene.bounds();
+    regrid();
+    input_cell_ = grid_.cell();
+    stamp_.resize(n);
+    for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
+}
+
+// The grid again, with cells of 4 median lengths of the live segments. As removals lengthen
+// the segments, a grid sized for the input's files each one in more and more cells (at 98%
+// removal about 50 input segments long: every query and every unlink read dozens of cells).
+// The checks do not depend on the order in which a query meets the segments.
+void LivePolylines::regrid() {
+    std::vector<double> lengths;
+    for (std::size_t l = 0; l < layers_.size(); ++l)
+        for (std::size_t i = 0; i < layers_[l].alive.size(); ++i)
+            if (has_segment(l, i))
+                lengths.push_back(
+                    glm::distance(layers_[l].pos[i], layers_[l].pos[layers_[l].next[i]]));
+    live_segments_ = gridded_segments_ = lengths.size();
     std::nth_element(lengths.begin(),
                      lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2),
                      lengths.end());
     const double median = lengths.empty() ? 1.0 : lengths[lengths.size() / 2];
-    std::size_t segments = 0;
-    for (std::size_t l = 0; l < n; ++l) segments += scene.layer(l).segment_count();
-    grid_ = make_segment_grid(std::max(4.0 * median, std::numeric_limits<double>::min()),
-                              scene.bounds(), segments);
-    for (std::size_t l = 0; l < n; ++l)
+    const double cell = std::max(4.0 * median, std::numeric_limits<double>::min());
+    grid_ = make_segment_grid(cell, bounds_, live_segments_);
+    for (std::size_t l = 0; l < layers_.size(); ++l)
         for (std::size_t i = 0; i < layers_[l].alive.size(); ++i)
             if (has_segment(l, i)) grid_.insert(ref(l, i), seg_box(l, i));
-    stamp_.resize(n);
-    for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
 }
 
 void LivePolylines::unlink(std::size_t l, std::size_t v) {
@@ -58,6 +69,7 @@ void LivePolylines::unlink(std::size_t l, std::size_t v) {
     w.prev[b] = a;
     --w.alive_count;
     grid_.insert(ref(l, a), seg_box(l, a));
+    if (--live_segments_ * 4 < gridded_segments_) regrid();
 }
 
 void LivePolylines::relink(std::size_t l, std::size_t v) {
@@ -70,6 +82,7 @@ void LivePolylines::relink(std::size_t l, std::size_t v) {
     ++w.alive_count;
     grid_.insert(ref(l, a), seg_box(l, a));
     grid_.insert(ref(l, v), seg_box(l, v));
+    ++live_segments_;
 }
 
 void LivePolylines::move(std::size_t l, std::size_t v, const Vec2& to) {

@@ -7,6 +7,7 @@
 #include "simplify/detail/work_layer.h"
 #include "strata/geometry/scene.h"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -44,6 +45,21 @@ class LivePolylines {
         });
     }
 
+    /// The cells of side input_cell() (4 median segment lengths of the input, corner of cell
+    /// (0, 0) at the origin) that a box touches: columns i0..i1, rows j0..j1, as the grid
+    /// built for the input numbers them.
+    struct CellRange {
+        long long i0 = 0, i1 = 0, j0 = 0, j1 = 0;
+        bool meets(const CellRange& o) const {
+            return i0 <= o.i1 && o.i0 <= i1 && j0 <= o.j1 && o.j0 <= j1;
+        }
+    };
+    double input_cell() const { return input_cell_; }
+    CellRange input_cells(const Box2& box) const {
+        return {input_cell_index(box.min.x), input_cell_index(box.max.x),
+                input_cell_index(box.min.y), input_cell_index(box.max.y)};
+    }
+
     /// `input` (layers, metadata) with the alive vertices of every layer, in order.
     Scene to_scene(const Scene& input) const;
     /// Per layer, the input id of every vertex of to_scene(), in the same order.
@@ -66,8 +82,22 @@ class LivePolylines {
     bool has_segment(std::size_t l, std::size_t i) const {
         return layers_[l].alive[i] && layers_[l].next[i] != kNone;
     }
+    // UniformGrid's cell numbering (to_cell()) for cells of side input_cell_ from 0.
+    long long input_cell_index(double x) const {
+        constexpr double kMax = 1099511627776.0;
+        const double v = x / input_cell_;
+        if (!(v > -kMax)) return -static_cast<long long>(kMax);
+        if (!(v < kMax)) return static_cast<long long>(kMax);
+        return static_cast<long long>(std::floor(v));
+    }
+    /// Builds grid_ again for the live segments; unlink() calls it when they are down to a
+    /// quarter of those it was built for (fewer builds; a half was no faster).
+    void regrid();
     std::vector<WorkLayer> layers_;
     SegmentGrid grid_;
+    double input_cell_ = 1.0;  // the cell of the grid built for the input
+    Box2 bounds_;              // the input's: where grid_ keeps its cells in a dense array
+    std::size_t live_segments_ = 0, gridded_segments_ = 0;  // now, and when grid_ was built
     std::vector<std::vector<std::uint32_t>> stamp_;  // per segment: last segments_near() to meet it
     std::uint32_t stamp_counter_ = 0;
 };

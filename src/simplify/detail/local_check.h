@@ -50,27 +50,50 @@ class LocalCheck {
   private:
     /// The closest segment of one layer to a point, within reach_.
     struct Closest {
-        bool wanted = false;   ///< The layer is asked for.
-        bool settled = false;  ///< Found (or nothing within reach_).
-        double best = 0.0;     ///< Its distance.
+        double best = 0.0;  ///< Its distance.
         std::size_t seg = kNone;
         Vec2 point{0.0};  ///< The closest point.
     };
-    /// The closest segment to p of every layer k with closest[k].wanted, at the overlay's
-    /// positions, as check_scene() finds it (the smallest segment index among equally close
-    /// ones; nothing farther than reach_).
-    void sides_against(const Vec2& p, const Overlay& ov, std::vector<Closest>& closest) const;
+    /// A segment of an open layer at the overlay's positions, with its box.
+    struct NearSegment {
+        std::size_t start = 0;
+        Vec2 a{0.0}, b{0.0};
+        Box2 box;
+    };
+    /// near[k]: the segments of open layer k (one under or over another layer) whose boxes
+    /// meet `box`, at the overlay's positions (zero-length ones left out).
+    void segments_near(const Box2& box, const Overlay& ov,
+                       std::vector<std::vector<NearSegment>>& near) const;
+    /// The closest of `segments` (one layer's, segments_near() of a box holding p inflated by
+    /// reach_) to p, as check_scene() finds it: the smallest segment index among equally close
+    /// ones, nothing (seg kNone) farther than reach_.
+    Closest closest_of(const Vec2& p, const std::vector<NearSegment>& segments) const;
     /// check_scene()'s side of open layer k at p, given its closest segment (0: nothing
     /// closer than reach_, closest to an end, or on the layer).
     int side_of_closest(std::size_t k, const Vec2& p, const Closest& c, const Overlay& ov) const;
     /// Vertex x of layer j, at its overlay position, is on its wanted side of every open layer
-    /// k it nests with. `closest`: scratch.
+    /// k it nests with. `near`: segments_near() of a box holding it inflated by reach_.
     bool keeps_sides(std::size_t j, std::size_t x, const Overlay& ov,
-                     std::vector<Closest>& closest) const;
+                     const std::vector<std::vector<NearSegment>>& near) const;
     bool on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, const Vec2& pb,
                         const Vec2& w) const;
-    bool triangle_empty(std::size_t l, std::size_t a, const Vec2& removed, std::size_t b,
-                        const Overlay& ov) const;
+    /// Segment (a, b) of layer l at its overlay positions p, q, and their box.
+    struct Chord {
+        std::size_t l, a, b;
+        Vec2 p, q;
+        Box2 box;
+    };
+    Chord chord_of(std::size_t l, std::size_t a, std::size_t b, const Overlay& ov) const;
+    /// Segment (k, u) meets the chord nowhere and keeps its separation from it.
+    bool clear_of_chord(const Chord& c, std::size_t k, std::size_t u, const Overlay& ov) const;
+    /// The closed triangle (pa, removed, pb) of a removal between a and b of layer l, its box.
+    struct Triangle {
+        std::size_t l, a, b;
+        Vec2 pa, removed, pb;
+        Box2 box;
+    };
+    bool clear_of_triangle(const Triangle& t, std::size_t k, std::size_t u,
+                           const Overlay& ov) const;
     void changed_segments(std::size_t k, const Overlay& ov, std::vector<Vec2>& olds,
                           std::vector<Vec2>& news) const;
 
@@ -81,6 +104,8 @@ class LocalCheck {
     const InputSides& sides_;
     double reach_ = 0.0;         // check_scene()'s automatic near distance of the input
     bool open_nesting_ = false;  // some open layer is under or over another layer
+    std::vector<char> open_under_over_;     // per layer: open, another layer under or over it
+    std::vector<char> under_or_over_open_;  // per layer: under or over an open layer
 };
 
 }  // namespace strata::detail

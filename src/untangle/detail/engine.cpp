@@ -4,6 +4,7 @@
 
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/predicates.h"
 #include "strata/untangle/shape_matching.h"
 
 #include <tbb/blocked_range.h>
@@ -28,6 +29,118 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The segments of one layer binned in a uniform grid by the box of each segment over two
+// states of the layer (`before` and `after` a step), so that one build answers for every state
+// in between that moves vertices from the one to the other: keep_simple()'s candidates.
+class SegmentBins {
+  public:
+    void build(const std::vector<Vec2>& before, const std::vector<Vec2>& after, bool closed) {
+        const std::size_t n = before.size();
+        segments_ = closed ? n : n - 1;
+        boxes_.assign(segments_, Box2{});
+        Box2 all;
+        for (std::size_t s = 0; s < segments_; ++s) {
+            for (const Vec2& p : {before[s], before[(s + 1) % n], after[s], after[(s + 1) % n]})
+                boxes_[s].extend(p);
+            all.extend(boxes_[s]);
+        }
+        const Vec2 size = all.max - all.min;
+        origin_ = all.min;
+        cell_ = std::max(std::max(size.x, size.y) / std::sqrt(static_cast<double>(segments_) + 1.0),
+                         std::numeric_limits<double>::min());
+        cells_.clear();
+        large_.clear();
+        for (std::size_t s = 0; s < segments_; ++s) {
+            const auto [x0, y0, x1, y1] = range(boxes_[s]);
+            if ((x1 - x0 + 1) * (y1 - y0 + 1) > kLargest) {
+                large_.push_back(s);
+                continue;
+            }
+            for (long long ix = x0; ix <= x1; ++ix)
+                for (long long iy = y0; iy <= y1; ++iy) cells_[pack(ix, iy)].push_back(s);
+        }
+        seen_.assign(segments_, 0);
+        stamp_ = 0;
+    }
+
+    // Calls f(s) once for every segment s whose box overlaps `box`.
+    template <class F>
+    void query(const Box2& box, F&& f) {
+        if (++stamp_ == 0) {
+            std::fill(seen_.begin(), seen_.end(), 0);
+            stamp_ = 1;
+        }
+        auto visit = [&](std::size_t s) {
+            if (seen_[s] == stamp_ || !boxes_[s].overlaps(box)) return;
+            seen_[s] = stamp_;
+            f(s);
+        };
+        for (std::size_t s : large_) visit(s);
+        const auto [x0, y0, x1, y1] = range(box);
+        if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) >
+            static_cast<double>(segments_)) {
+            for (std::size_t s = 0; s < segments_; ++s) visit(s);
+            return;
+        }
+        for (long long ix = x0; ix <= x1; ++ix)
+            for (long long iy = y0; iy <= y1; ++iy) {
+                const auto it = cells_.find(pack(ix, iy));
+                if (it != cells_.end())
+                    for (std::size_t s : it->second) visit(s);
+            }
+    }
+
+  private:
+    static constexpr long long kLargest = 16;  // cells a segment is binned in, at most
+    struct Range {
+        long long x0, y0, x1, y1;
+    };
+    Range range(const Box2& b) const {
+        auto c = [this](double v, double o) {
+            return static_cast<long long>(std::floor((v - o) / cell_));
+        };
+        return {c(b.min.x, origin_.x), c(b.min.y, origin_.y), c(b.max.x, origin_.x),
+                c(b.max.y, origin_.y)};
+    }
+    static std::uint64_t pack(long long ix, long long iy) {
+        return (static_cast<std::uint64_t>(ix) << 32) ^
+               (static_cast<std::uint64_t>(iy) & 0xffffffffULL);
+    }
+    std::size_t segments_ = 0;
+    std::vector<Box2> boxes_;
+    Vec2 origin_{0.0};
+    double cell_ = 1.0;
+    std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
+    std::vector<std::size_t> large_;
+    std::vector<unsigned> seen_;
+    unsigned stamp_ = 0;
+};
+
+// Number of segments of `x` (open unless `closed`, binned in `bins`) other than the two at
+// vertex v and their neighbours that the two segments at v meet (segment_contact() not None).
+std::size_t own_contacts(const std::vector<Vec2>& x, bool closed, std::size_t v,
+                         SegmentBins& bins) {
+    const std::size_t n = x.size();
+    std::size_t count = 0;
+    for (int side = 0; side < 2; ++side) {
+        // The segment (v - 1, v) or (v, v + 1), as the index of its first vertex.
+        if (side == 0 && !closed && v == 0) continue;
+        if (side == 1 && !closed && v + 1 >= n) continue;
+        const std::size_t s = side == 0 ? (v + n - 1) % n : v;
+        const Vec2 a = x[s], b = x[(s + 1) % n];
+        Box2 box;
+        box.extend(a);
+        box.extend(b);
+        bins.query(box, [&](std::size_t t) {
+            // Skip s itself and the segments sharing a vertex with it.
+            const std::size_t d = (t + n - s) % n;
+            if (d == 0 || d == 1 || (closed ? d == n - 1 : t + 1 == s)) return;
+            if (segment_contact(a, b, x[t], x[(t + 1) % n]) != SegmentContact::None) ++count;
+        });
+    }
+    return count;
 }
 
 // Uniform hash grid of vertices, rebuilt at every projection step: finds the vertices of other
@@ -418,9 +531,28 @@ class Pass {
                 next_[v] = x[v] + d;
                 moved += glm::length(d);
             }
+            if (keep_simple_) keep_simple(piece, layer.closed, x, next_);
             scene.set_points(piece.layer, next_);
         }
         return moved;
+    }
+
+    // EngineSettings::keep_simple: the moves of `piece` from `before` to `after` taken one
+    // vertex at a time, in order; a move whose two segments meet more segments of the layer
+    // than they did before it is not made (the vertex stays where it was), so the layer never
+    // gets a self-crossing it did not have.
+    void keep_simple(const Piece& piece, bool closed, const std::vector<Vec2>& before,
+                     std::vector<Vec2>& after) {
+        state_ = before;
+        bins_.build(before, after, closed);
+        for (std::size_t k = 0; k < piece.vertices.size(); ++k) {
+            const std::size_t v = piece.vertices[k];
+            if (after[v] == before[v]) continue;
+            const std::size_t was = own_contacts(state_, closed, v, bins_);
+            state_[v] = after[v];
+            if (own_contacts(state_, closed, v, bins_) > was) state_[v] = before[v];
+        }
+        after = state_;
     }
 
     // The largest |fhat - f| over the samples of the last project() (scene units).
@@ -456,11 +588,17 @@ class Pass {
             next_ = layer.points;
             for (std::size_t k = 0; k < piece.vertices.size(); ++k)
                 next_[piece.vertices[k]] = current_[k];
+            if (keep_simple_) keep_simple(piece, layer.closed, layer.points, next_);
             scene.set_points(piece.layer, next_);
         }
     }
 
+    void set_keep_simple(bool on) { keep_simple_ = on; }
+
   private:
+    bool keep_simple_ = false;  // EngineSettings::keep_simple
+    std::vector<Vec2> state_;   // keep_simple()'s scratch
+    SegmentBins bins_;
     const SceneFields& fields_;
     const RelationSource& relations_;
     const UntangleParams& params_;
@@ -664,6 +802,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                 : std::max(settings.min_separation, 0.25 * fields.params().voxel_size);
         start = Clock::now();
         Pass engine(work, relations, fields, params, separation, settings.sample_spacing);
+        engine.set_keep_simple(settings.keep_simple);
         result.converged = false;
         if (!settings.rest_at_start) rest = shapes_of(work, pieces);
         for (int round = 0; round < params.max_rounds; ++round) {

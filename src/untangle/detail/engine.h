@@ -84,6 +84,11 @@ struct EngineSettings {
     /// its second round on (untangle(), whose passes are long: each pass settles from where
     /// the previous one left the layers).
     bool rest_at_start = false;
+    /// The projection steps and shape matching move no vertex so that its segments meet more
+    /// segments of its own layer than before (the moves are taken one vertex at a time, in
+    /// order): no self-crossing is made. untangle() only; the driver's untanglings (which
+    /// check a region, whole layers being long) leave it off.
+    bool keep_simple = false;
 };
 
 /// What run_engine() did.

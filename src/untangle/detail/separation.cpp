@@ -145,8 +145,13 @@ class SegmentCells {
     double drift_ = 0.0;                    // largest move since the build
 };
 
+// p lies in the closed triangle (a, b, c). The side (a, b) is tested last, and only when the
+// other two leave p possibly inside: is_safe() passes a vertex's move there, often so short
+// that orient2d() on it falls to its exact (rational) stage.
 bool in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
-    const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    const int o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    if (o2 * o3 < 0) return false;
+    const int o1 = orient2d(a, b, p);
     return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
 }
 
@@ -166,6 +171,7 @@ class Finisher {
                 if (piece.is_free[k])
                     inverse_mass_[piece.layer][piece.vertices[k]] =
                         1.0 / relations.weight(piece.layer);
+        slot_.assign(n, -1);
         aim_.assign(n * n, 0.0);
         relation_.assign(n * n, Relation::Same);
         for (std::size_t a = 0; a < n; ++a)
@@ -282,17 +288,30 @@ class Finisher {
             if (s.layer != l && relation_[l * n + s.layer] != Relation::Same) found_.push_back(s);
         });
         if (found_.empty()) return;
-        // The nearest segment of each layer, and whether the vertex is on its wrong side.
+        // The nearest segment of each layer, and whether the vertex is on its wrong side. Only
+        // a segment closer than tangle_reach_ can make the vertex wrong or be pushed (every
+        // aim is within it): one whose box is farther is not measured (distance +inf; its
+        // layer's entry stays +inf and not wrong unless a closer one comes).
+        const Vec2 p0 = pts_[l][v];
+        // (A margin far above the rounding of the closest point, at any offset.)
+        const double far = tangle_reach_ + 1e-9 * (tangle_reach_ + std::abs(p0.x) + std::abs(p0.y));
         nearest_.clear();
+        distance_.resize(found_.size());
         for (std::size_t i = 0; i < found_.size(); ++i) {
             const SegId& s = found_[i];
-            const double d = point_segment_distance(pts_[l][v], cells_->start(s), cells_->end(s));
-            auto it = std::find_if(nearest_.begin(), nearest_.end(),
-                                   [&](const Nearest& x) { return x.layer == s.layer; });
-            if (it == nearest_.end())
+            const Vec2 a = cells_->start(s), b = cells_->end(s);
+            const double gap = std::max({std::min(a.x, b.x) - p0.x, p0.x - std::max(a.x, b.x),
+                                         std::min(a.y, b.y) - p0.y, p0.y - std::max(a.y, b.y)});
+            const double d = gap > far ? std::numeric_limits<double>::infinity()
+                                       : point_segment_distance(p0, a, b);
+            distance_[i] = d;
+            std::int32_t& slot = slot_[s.layer];
+            if (slot < 0) {
+                slot = static_cast<std::int32_t>(nearest_.size());
                 nearest_.push_back({s.layer, i, d, false, 0});
-            else if (d < it->distance)
-                *it = {s.layer, i, d, false, 0};
+            } else if (d < nearest_[static_cast<std::size_t>(slot)].distance) {
+                nearest_[static_cast<std::size_t>(slot)] = {s.layer, i, d, false, 0};
+            }
         }
         for (Nearest& x : nearest_) {
             const SegId& s = found_[x.index];
@@ -308,13 +327,15 @@ class Finisher {
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
                          orient2d(q0, q1, p) != wanted;
         }
+        const std::size_t moves_before = result.moves;
         for (std::size_t i = 0; i < found_.size(); ++i) {
             const SegId& s = found_[i];
             const std::size_t m = s.layer;
-            const Nearest& near = *std::find_if(nearest_.begin(), nearest_.end(),
-                                                [&](const Nearest& x) { return x.layer == m; });
+            const Nearest& near = nearest_[static_cast<std::size_t>(slot_[m])];
             if (near.is_wrong && near.index != i) continue;  // the tangle first
             const double aim = aim_[l * n + m];
+            // Nothing moved yet in this call: the distance measured above is the one below.
+            if (!near.is_wrong && result.moves == moves_before && !(distance_[i] < aim)) continue;
             const std::size_t k0 = s.index, k1 = (s.index + 1) % layer_size(m);
             const Vec2 p = pts_[l][v], q0 = pts_[m][k0], q1 = pts_[m][k1];
             const double wp = inverse_mass_[l][v], w0 = inverse_mass_[m][k0],
@@ -350,6 +371,7 @@ class Finisher {
                 try_move(m, k0, -w0 * (1.0 - t) * lambda * normal, result, changed);
             if (w1 > 0.0 && t > 0.0) try_move(m, k1, -w1 * t * lambda * normal, result, changed);
         }
+        for (const Nearest& x : nearest_) slot_[x.layer] = -1;
     }
 
     // The foot of p on segment (q0, q1) lies strictly inside it.
@@ -478,7 +500,7 @@ class Finisher {
             for (std::size_t e = 0; e < 2 && safe; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
                 const Vec2 w = pts_[s.layer][ends[e]];
-                if (has_prev && in_closed_triangle(pts_[l][prev], p, to, w)) safe = false;
+                if (has_prev && in_closed_triangle(p, to, pts_[l][prev], w)) safe = false;
                 if (has_next && in_closed_triangle(p, to, pts_[l][next], w)) safe = false;
             }
         });
@@ -504,9 +526,11 @@ class Finisher {
         int wanted;  // the side the vertex must be on (orient2d sign), 0: any
     };
     std::vector<Nearest> nearest_;
+    std::vector<std::int32_t> slot_;  // per work layer: its entry in nearest_, -1: none
     std::optional<SegmentCells> cells_;
     std::vector<SegId> active_;  // (layer, vertex) of the vertices near the free ones
     std::vector<SegId> found_;
+    std::vector<double> distance_;  // from the vertex relaxed to each of found_, as found
     double worst_ = 0.0;
     std::size_t wrong_side_ = 0;
 };
