@@ -301,9 +301,9 @@ class SegmentIndex {
     struct Ends {
         Vec2 a, b;
     };
-    std::vector<Ends> ends_;  // the ends of each kept segment, by position
+    std::vector<Ends> ends_;    // the ends of each kept segment, by position
     std::uint64_t serial_ = 0;  // tells the cursors of this index (and its copies) from others
-    double magnitude_ = 0.0;  // largest absolute coordinate of the layer
+    double magnitude_ = 0.0;    // largest absolute coordinate of the layer
     double chunk_length_ = 0.0;
     std::vector<Box2> chunk_boxes_;  // chunk c: kept segments [c kChunk, (c + 1) kChunk)
     detail::UniformGrid<std::uint32_t> chunk_grid_;
