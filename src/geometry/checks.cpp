@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -330,44 +329,6 @@ double automatic_near(const Scene& scene) {
 // point there within `near` (not found when farther): +1 right of the direction of travel, -1
 // left, 0 when not decided (farther than `near`, on the layer, or closest to an end point of
 // an open layer).
-// orient2d(a, b, c) where a floating-point filter decides it (with a bound 30 times
-// Shewchuk's, and products far from underflow, the sign found is the exact one), else
-// orient2d() itself: the same value, without a call on the common path.
-inline int orient_filtered(const Vec2& a, const Vec2& b, const Vec2& c) {
-    const double left = (a.x - c.x) * (b.y - c.y);
-    const double right = (a.y - c.y) * (b.x - c.x);
-    const double det = left - right;
-    const double sum = std::abs(left) + std::abs(right);
-    if (sum > 1e-250 && sum < 1e250) {
-        const double bound = 1e-14 * sum;
-        if (det > bound) return 1;
-        if (-det > bound) return -1;
-    }
-    return orient2d(a, b, c);
-}
-
-// segment_side() and corner_side() of src/geometry/input_sides.cpp, the same rule with
-// orient_filtered() (a debug build checks that they agree).
-inline int segment_side_filtered(const Vec2& a, const Vec2& b, const Vec2& v) {
-    const int side = -orient_filtered(a, b, v);
-    assert(side == segment_side(a, b, v));
-    return side;
-}
-inline int corner_side_filtered(const Vec2& u, const Vec2& w, const Vec2& x, const Vec2& v) {
-    const int turn = orient_filtered(u, w, x);
-    const int o1 = orient_filtered(u, w, v);
-    const int o2 = orient_filtered(w, x, v);
-    int side = 0;
-    if (turn > 0)
-        side = (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
-    else if (turn < 0)
-        side = (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
-    else
-        side = o1 != 0 ? -o1 : -o2;
-    assert(side == corner_side(u, w, x, v));
-    return side;
-}
-
 int side_of(const SegmentIndex& index, const Vec2& v, const Nearest& n) {
     if (!n.found() || n.distance == 0.0) return 0;
     const std::size_t s = n.segment;
@@ -383,8 +344,8 @@ int side_of(const SegmentIndex& index, const Vec2& v, const Nearest& n) {
         before = s;
         after = index.next(s);
     }
-    if (before == kNone || after == kNone) return segment_side_filtered(a, b, v);
-    return corner_side_filtered(index.start(before), index.end(before), index.end(after), v);
+    if (before == kNone || after == kNone) return segment_side(a, b, v);
+    return corner_side(index.start(before), index.end(before), index.end(after), v);
 }
 
 // side_of() at the closest point within `near`; `cursor`: the previous vertex's query along
@@ -499,7 +460,7 @@ Vec2 touch_point(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1)
 // Adjacent segments [u, v] and [v, w] that fold back onto each other: collinear, opposite
 // directions. Sets `point` to the representative point of their overlap.
 bool folds_back(const Vec2& u, const Vec2& v, const Vec2& w, Vec2& point) {
-    if (orient_filtered(u, v, w) != 0) return false;
+    if (orient2d(u, v, w) != 0) return false;
     const bool use_x = u.x != v.x;
     const double cu = use_x ? u.x : u.y, cv = use_x ? v.x : v.y, cw = use_x ? w.x : w.y;
     if ((cv > cu) == (cw > cv)) return false;

@@ -125,19 +125,6 @@ std::size_t InputSides::rolled_count(const Scene& scene,
     return count;
 }
 
-int corner_side(const Vec2& u, const Vec2& w, const Vec2& x, const Vec2& v) {
-    const int turn = orient2d(u, w, x);
-    const int o1 = orient2d(u, w, v);
-    const int o2 = orient2d(w, x, v);
-    if (turn > 0) return (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
-    if (turn < 0) return (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
-    return o1 != 0 ? -o1 : -o2;
-}
-
-int segment_side(const Vec2& a, const Vec2& b, const Vec2& v) {
-    return -orient2d(a, b, v);
-}
-
 int global_side(Relation relation_of_a_to_b, int outside) {
     switch (relation_of_a_to_b) {
         case Relation::Under:

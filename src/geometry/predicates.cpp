@@ -20,45 +20,19 @@ namespace {
 
 using Rational = boost::multiprecision::cpp_rational;
 
-// Shewchuk's bound for the first stage of orient2d: (3 + 16 eps) eps with eps = 2^-53.
-constexpr double kEpsilon = std::numeric_limits<double>::epsilon() * 0.5;
-constexpr double kOrientBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
-// Below this magnitude products may be subnormal and the relative bound no longer holds.
-constexpr double kTinyProduct = 1e-280;
-
 int sign_of(const Rational& value) {
     return value > 0 ? 1 : (value < 0 ? -1 : 0);
 }
 
-int orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c) {
+}  // namespace
+
+int detail::orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c) {
     // Every double is a dyadic rational: the conversions and the arithmetic are exact.
     const Rational acx = Rational(a.x) - Rational(c.x);
     const Rational bcx = Rational(b.x) - Rational(c.x);
     const Rational acy = Rational(a.y) - Rational(c.y);
     const Rational bcy = Rational(b.y) - Rational(c.y);
     return sign_of(acx * bcy - acy * bcx);
-}
-
-// Sign of x (-1, 0, +1), compared exactly.
-int sign_of(double x) {
-    return (x > 0.0) - (x < 0.0);
-}
-
-}  // namespace
-
-int orient2d(const Vec2& a, const Vec2& b, const Vec2& c) {
-    const double detleft = (a.x - c.x) * (b.y - c.y);
-    const double detright = (a.y - c.y) * (b.x - c.x);
-    const double det = detleft - detright;
-    const double detsum = std::fabs(detleft) + std::fabs(detright);
-    // Overflow, or products so small that underflow may have spoiled them: decide exactly.
-    if (!std::isfinite(det) || detsum < kTinyProduct) return orient2d_exact(a, b, c);
-    // Products of opposite signs (or one zero): the sign of det is exact.
-    if ((detleft >= 0.0) != (detright > 0.0) || detleft == 0.0) return sign_of(det);
-    const double bound = kOrientBound * detsum;
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-    return orient2d_exact(a, b, c);
 }
 
 SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {

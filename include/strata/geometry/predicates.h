@@ -11,9 +11,29 @@
 
 namespace strata {
 
+namespace detail {
+/// orient2d() by exact rational arithmetic.
+int orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c);
+}  // namespace detail
+
 /// Sign of the area of triangle (a, b, c): +1 counter-clockwise (c left of a->b), -1
-/// clockwise, 0 collinear. Exact.
-int orient2d(const Vec2& a, const Vec2& b, const Vec2& c);
+/// clockwise, 0 collinear. Exact: the floating-point filter below (inline: the checks call it
+/// hundreds of thousands of times) decides almost every case, exact arithmetic the rest.
+inline int orient2d(const Vec2& a, const Vec2& b, const Vec2& c) {
+    const double left = (a.x - c.x) * (b.y - c.y);
+    const double right = (a.y - c.y) * (b.x - c.x);
+    const double det = left - right;
+    const double sum = std::fabs(left) + std::fabs(right);
+    // Products far from underflow and overflow (NaN fails both tests): Shewchuk's bound for
+    // the first stage, (3 + 16 eps) eps with eps = 2^-53, holds.
+    if (sum > 1e-280 && sum < 1e280) {
+        constexpr double kEpsilon = 0x1p-53;
+        const double bound = (3.0 + 16.0 * kEpsilon) * kEpsilon * sum;
+        if (det > bound) return 1;
+        if (-det > bound) return -1;
+    }
+    return detail::orient2d_exact(a, b, c);
+}
 
 /// How two closed segments meet. Exact.
 enum class SegmentContact {

@@ -316,14 +316,16 @@ class UniformGrid {
         return bytes;
     }
 
-  private:
-    // Cell numbers are clamped to +-2^40: a coordinate far out (or NaN) stays a valid number.
+    /// The number of the cell holding coordinate `v` (in cells from the origin): floor(v),
+    /// clamped to +-2^40, so that a coordinate far out (or NaN) stays a valid number.
     static long long to_cell(double v) {
         constexpr double kMax = 1099511627776.0;
         if (!(v > -kMax)) return -static_cast<long long>(kMax);
         if (!(v < kMax)) return static_cast<long long>(kMax);
         return static_cast<long long>(std::floor(v));
     }
+
+  private:
     long long column(double x) const { return to_cell((x - params_.origin.x) / params_.cell); }
     long long row(double y) const { return to_cell((y - params_.origin.y) / params_.cell); }
 

@@ -7,7 +7,6 @@
 #include "simplify/detail/work_layer.h"
 #include "strata/geometry/scene.h"
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -82,14 +81,8 @@ class LivePolylines {
     bool has_segment(std::size_t l, std::size_t i) const {
         return layers_[l].alive[i] && layers_[l].next[i] != kNone;
     }
-    // UniformGrid's cell numbering (to_cell()) for cells of side input_cell_ from 0.
-    long long input_cell_index(double x) const {
-        constexpr double kMax = 1099511627776.0;
-        const double v = x / input_cell_;
-        if (!(v > -kMax)) return -static_cast<long long>(kMax);
-        if (!(v < kMax)) return static_cast<long long>(kMax);
-        return static_cast<long long>(std::floor(v));
-    }
+    // The number of the cell of side input_cell_ (from 0) holding x, as the grid numbers it.
+    long long input_cell_index(double x) const { return SegmentGrid::to_cell(x / input_cell_); }
     /// Builds grid_ again for the live segments; unlink() calls it when they are down to a
     /// quarter of those it was built for (fewer builds; a half was no faster).
     void regrid();
