@@ -482,12 +482,31 @@ class Finisher {
         auto is_mover = [&](std::size_t m, std::size_t k) {
             return m == l && (k == v || (has_prev && k == prev) || (has_next && k == next));
         };
+        // segment_contact()'s box test first, inline: most segments near a move miss it.
         auto meets = [](const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
+            if (std::max(a0.x, a1.x) < std::min(b0.x, b1.x) ||
+                std::max(b0.x, b1.x) < std::min(a0.x, a1.x) ||
+                std::max(a0.y, a1.y) < std::min(b0.y, b1.y) ||
+                std::max(b0.y, b1.y) < std::min(a0.y, a1.y))
+                return false;
             return segment_contact(a0, a1, b0, b1) != SegmentContact::None;
         };
+        // The boxes of the triangles swept by the old segments.
+        Box2 sweep_prev, sweep_next;
+        sweep_prev.extend(p);
+        sweep_prev.extend(to);
+        sweep_next = sweep_prev;
+        if (has_prev) sweep_prev.extend(pts_[l][prev]);
+        if (has_next) sweep_next.extend(pts_[l][next]);
         cells_->query(box, [&](const SegId& s) {
             if (!safe) return;
             const Vec2 a = cells_->start(s), b = cells_->end(s);
+            // Everything tested below lies in `box`: the new and old segments and the swept
+            // triangles. A segment whose box is apart from it can neither meet them nor have
+            // an end inside a triangle (exact comparisons, as segment_contact()'s own).
+            if (std::max(a.x, b.x) < box.min.x || std::min(a.x, b.x) > box.max.x ||
+                std::max(a.y, b.y) < box.min.y || std::min(a.y, b.y) > box.max.y)
+                return;
             const bool with_prev = has_prev && !shares_end(s, prev, v);
             const bool with_next = has_next && !shares_end(s, v, next);
             const int now = (with_prev && meets(pts_[l][prev], to, a, b) ? 1 : 0) +
@@ -500,8 +519,13 @@ class Finisher {
             for (std::size_t e = 0; e < 2 && safe; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
                 const Vec2 w = pts_[s.layer][ends[e]];
-                if (has_prev && in_closed_triangle(p, to, pts_[l][prev], w)) safe = false;
-                if (has_next && in_closed_triangle(p, to, pts_[l][next], w)) safe = false;
+                if (!box.contains(w)) continue;
+                if (has_prev && sweep_prev.contains(w) &&
+                    in_closed_triangle(p, to, pts_[l][prev], w))
+                    safe = false;
+                if (has_next && sweep_next.contains(w) &&
+                    in_closed_triangle(p, to, pts_[l][next], w))
+                    safe = false;
             }
         });
         return safe;
