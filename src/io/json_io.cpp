@@ -301,6 +301,7 @@ class FastScene {
     // `text` followed by `capacity` - text.size() readable bytes: simdjson reads up to
     // SIMDJSON_PADDING bytes past the end, and copies a text without that room.
     bool read(std::string_view text, std::size_t capacity) {
+        if (text.empty()) return false;  // (an empty view may hold no buffer at all)
         simdjson::dom::parser parser;
         simdjson::dom::element root;
         const bool parsed =
