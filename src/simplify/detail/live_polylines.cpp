@@ -9,7 +9,7 @@
 namespace strata::detail {
 
 LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>& targets)
-    : grid_(make_segment_grid(1.0)) {
+    : grid_(make_segment_grid<LiveSegment>(1.0)) {
     const std::size_t n = scene.size();
     layers_.resize(n);
     for (std::size_t l = 0; l < n; ++l) {
@@ -32,8 +32,6 @@ LivePolylines::LivePolylines(const Scene& scene, const std::vector<std::size_t>&
     bounds_ = scene.bounds();
     regrid();
     input_cell_ = grid_.cell();
-    stamp_.resize(n);
-    for (std::size_t l = 0; l < n; ++l) stamp_[l].assign(layers_[l].alive.size(), 0);
 }
 
 // The grid again, with cells of 4 median lengths of the live segments. As removals lengthen
@@ -53,35 +51,46 @@ void LivePolylines::regrid() {
                      lengths.end());
     const double median = lengths.empty() ? 1.0 : lengths[lengths.size() / 2];
     const double cell = std::max(4.0 * median, std::numeric_limits<double>::min());
-    grid_ = make_segment_grid(cell, bounds_, live_segments_);
+    grid_ = make_segment_grid<LiveSegment>(cell, bounds_, live_segments_);
     for (std::size_t l = 0; l < layers_.size(); ++l)
         for (std::size_t i = 0; i < layers_[l].alive.size(); ++i)
-            if (has_segment(l, i)) grid_.insert(ref(l, i), seg_box(l, i));
+            if (has_segment(l, i)) grid_.insert(record(l, i), seg_box(l, i));
+}
+
+LiveSegment LivePolylines::record(std::size_t l, std::size_t i) const {
+    const WorkLayer& w = layers_[l];
+    LiveSegment s = key(l, i);
+    const std::size_t e = w.next[i];
+    s.end = static_cast<std::uint32_t>(e);
+    s.end_is_last = w.next[e] == kNone;
+    s.p = w.pos[i];
+    s.q = w.pos[e];
+    return s;
 }
 
 void LivePolylines::unlink(std::size_t l, std::size_t v) {
     WorkLayer& w = layers_[l];
     const std::size_t a = w.prev[v], b = w.next[v];
-    grid_.erase(ref(l, a), seg_box(l, a));
-    grid_.erase(ref(l, v), seg_box(l, v));
+    grid_.erase(key(l, a), seg_box(l, a));
+    grid_.erase(key(l, v), seg_box(l, v));
     w.alive[v] = 0;
     w.next[a] = b;
     w.prev[b] = a;
     --w.alive_count;
-    grid_.insert(ref(l, a), seg_box(l, a));
+    grid_.insert(record(l, a), seg_box(l, a));
     if (--live_segments_ * 4 < gridded_segments_) regrid();
 }
 
 void LivePolylines::relink(std::size_t l, std::size_t v) {
     WorkLayer& w = layers_[l];
     const std::size_t a = w.prev[v], b = w.next[v];
-    grid_.erase(ref(l, a), seg_box(l, a));
+    grid_.erase(key(l, a), seg_box(l, a));
     w.alive[v] = 1;
     w.next[a] = v;
     w.prev[b] = v;
     ++w.alive_count;
-    grid_.insert(ref(l, a), seg_box(l, a));
-    grid_.insert(ref(l, v), seg_box(l, v));
+    grid_.insert(record(l, a), seg_box(l, a));
+    grid_.insert(record(l, v), seg_box(l, v));
     ++live_segments_;
 }
 
@@ -89,11 +98,11 @@ void LivePolylines::move(std::size_t l, std::size_t v, const Vec2& to) {
     WorkLayer& w = layers_[l];
     if (w.pos[v] == to) return;
     const std::size_t a = w.prev[v];
-    if (a != kNone) grid_.erase(ref(l, a), seg_box(l, a));
-    if (w.next[v] != kNone) grid_.erase(ref(l, v), seg_box(l, v));
+    if (a != kNone) grid_.erase(key(l, a), seg_box(l, a));
+    if (w.next[v] != kNone) grid_.erase(key(l, v), seg_box(l, v));
     w.pos[v] = to;
-    if (a != kNone) grid_.insert(ref(l, a), seg_box(l, a));
-    if (w.next[v] != kNone) grid_.insert(ref(l, v), seg_box(l, v));
+    if (a != kNone) grid_.insert(record(l, a), seg_box(l, a));
+    if (w.next[v] != kNone) grid_.insert(record(l, v), seg_box(l, v));
 }
 
 std::vector<std::vector<std::size_t>> LivePolylines::origins() const {

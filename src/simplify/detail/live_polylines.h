@@ -1,6 +1,6 @@
 #pragma once
 /// @file The polylines being simplified: one WorkLayer per input layer (its alive vertices
-/// linked in order) and the SegmentGrid of their live segments, kept in step as vertices are
+/// linked in order) and the LiveSegmentGrid of their live segments, kept in step as vertices are
 /// unlinked, relinked or moved. Private to src/simplify.
 
 #include "simplify/detail/segment_grid.h"
@@ -21,7 +21,7 @@ class LivePolylines {
     std::size_t size() const { return layers_.size(); }
     const WorkLayer& layer(std::size_t l) const { return layers_[l]; }
     /// The live segments, each indexed by its bounding box.
-    const SegmentGrid& grid() const { return grid_; }
+    const LiveSegmentGrid& grid() const { return grid_; }
     /// Vertex v of layer l is not to be removed any more.
     void lock(std::size_t l, std::size_t v) { layers_[l].locked[v] = 1; }
 
@@ -34,14 +34,18 @@ class LivePolylines {
 
     /// Calls f(layer, start) once per live segment whose box meets `box`.
     template <class F>
-    void segments_near(const Box2& box, F&& f) {
-        ++stamp_counter_;
-        grid_.query(box, [&](SegRef s) {
-            std::uint32_t& mark = stamp_[s.layer][s.start];
-            if (mark == stamp_counter_) return;
-            mark = stamp_counter_;
+    void segments_near(const Box2& box, F&& f) const {
+        live_segments_near(box, [&](const LiveSegment& s) {
             f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
         });
+    }
+    /// Calls f(segment) once per live segment whose box meets `box`. Marks nothing: a segment
+    /// filed in several cells is reported from one of them, by the box its record holds
+    /// (UniformGrid::query_once).
+    template <class F>
+    void live_segments_near(const Box2& box, F&& f) const {
+        grid_.query_once(
+            box, [](const LiveSegment& s) { return s.box(); }, f);
     }
 
     /// The cells of side input_cell() (4 median segment lengths of the input, corner of cell
@@ -82,17 +86,24 @@ class LivePolylines {
         return layers_[l].alive[i] && layers_[l].next[i] != kNone;
     }
     // The number of the cell of side input_cell_ (from 0) holding x, as the grid numbers it.
-    long long input_cell_index(double x) const { return SegmentGrid::to_cell(x / input_cell_); }
+    long long input_cell_index(double x) const { return LiveSegmentGrid::to_cell(x / input_cell_); }
     /// Builds grid_ again for the live segments; unlink() calls it when they are down to a
     /// quarter of those it was built for (fewer builds; a half was no faster).
     void regrid();
     std::vector<WorkLayer> layers_;
-    SegmentGrid grid_;
+    /// Segment (l, i) as grid_ files it (alive, not the last vertex of an open layer).
+    LiveSegment record(std::size_t l, std::size_t i) const;
+    /// The name grid_.erase() matches segment (l, i) by.
+    static LiveSegment key(std::size_t l, std::size_t i) {
+        LiveSegment s;
+        s.layer = static_cast<std::uint32_t>(l);
+        s.start = static_cast<std::uint32_t>(i);
+        return s;
+    }
+    LiveSegmentGrid grid_;
     double input_cell_ = 1.0;  // the cell of the grid built for the input
     Box2 bounds_;              // the input's: where grid_ keeps its cells in a dense array
     std::size_t live_segments_ = 0, gridded_segments_ = 0;  // now, and when grid_ was built
-    std::vector<std::vector<std::uint32_t>> stamp_;  // per segment: last segments_near() to meet it
-    std::uint32_t stamp_counter_ = 0;
 };
 
 }  // namespace strata::detail

@@ -74,6 +74,14 @@ bool LocalCheck::removal_clear(std::size_t l, std::size_t a, const Vec2& removed
     Box2 query = chord.box.inflated(separations_.reach[l]);
     query.extend(triangle.box);
     bool ok = true;
+    if (!ov.job()) {  // live positions: what the checks read is in the grid's records
+        live_.live_segments_near(query, [&](const LiveSegment& s) {
+            ok = ok &&
+                 triangle_clear_of(triangle, s.layer, s.start, s.end, s.end_is_last, s.p, s.q) &&
+                 chord_clear_of(chord, s.layer, s.start, s.end, s.p, s.q);
+        });
+        return ok;
+    }
     ov.near(query, [&](std::size_t k, std::size_t u) {
         ok = ok && clear_of_triangle(triangle, k, u, ov) && clear_of_chord(chord, k, u, ov);
     });
@@ -101,7 +109,12 @@ bool LocalCheck::clear_of_chord(const Chord& c, std::size_t k, std::size_t u,
                                 const Overlay& ov) const {
     const std::size_t u2 = live_.layer(k).next[u];
     if (k == c.l && (u == c.a || u == c.b || u2 == c.a || u2 == c.b)) return true;
-    const Vec2 s0 = ov.pos(k, u), s1 = ov.pos(k, u2);
+    return chord_clear_of(c, k, u, u2, ov.pos(k, u), ov.pos(k, u2));
+}
+
+bool LocalCheck::chord_clear_of(const Chord& c, std::size_t k, std::size_t u, std::size_t u2,
+                                const Vec2& s0, const Vec2& s1) const {
+    if (k == c.l && (u == c.a || u == c.b || u2 == c.a || u2 == c.b)) return true;
     Box2 other;
     other.extend(s0);
     other.extend(s1);
@@ -140,14 +153,21 @@ bool LocalCheck::on_wanted_side(std::size_t k, std::size_t l, const Vec2& pa, co
 bool LocalCheck::clear_of_triangle(const Triangle& t, std::size_t k, std::size_t u,
                                    const Overlay& ov) const {
     const std::vector<std::size_t>& next = live_.layer(k).next;
-    for (std::size_t x : {u, next[u]}) {
-        if (x != u && next[x] != kNone) continue;
+    const std::size_t u2 = next[u];
+    return triangle_clear_of(t, k, u, u2, next[u2] == kNone, ov.pos(k, u), ov.pos(k, u2), &ov);
+}
+
+bool LocalCheck::triangle_clear_of(const Triangle& t, std::size_t k, std::size_t u, std::size_t u2,
+                                   bool u2_is_last, const Vec2& s0, const Vec2& s1,
+                                   const Overlay* ov) const {
+    for (const std::size_t x : {u, u2}) {
+        if (x != u && !u2_is_last) continue;
         if (k == t.l && (x == t.a || x == t.b)) continue;
-        const Vec2 w = ov.pos(k, x);
+        const Vec2& w = x == u ? s0 : s1;
         if (point_in_closed_triangle(t.box, t.pa, t.removed, t.pb, w)) {
             // After an untangling the triangle is no longer swept: a vertex of another layer
             // may have moved into it from the side it belongs on.
-            if (ov.job() && k != t.l && on_wanted_side(k, t.l, t.pa, t.pb, w)) continue;
+            if (ov && ov->job() && k != t.l && on_wanted_side(k, t.l, t.pa, t.pb, w)) continue;
             return false;
         }
     }

@@ -86,6 +86,9 @@ class LocalCheck {
     Chord chord_of(std::size_t l, std::size_t a, std::size_t b, const Overlay& ov) const;
     /// Segment (k, u) meets the chord nowhere and keeps its separation from it.
     bool clear_of_chord(const Chord& c, std::size_t k, std::size_t u, const Overlay& ov) const;
+    /// clear_of_chord() given the segment: from u to u2 (its next alive vertex), at s0, s1.
+    bool chord_clear_of(const Chord& c, std::size_t k, std::size_t u, std::size_t u2,
+                        const Vec2& s0, const Vec2& s1) const;
     /// The closed triangle (pa, removed, pb) of a removal between a and b of layer l, its box.
     struct Triangle {
         std::size_t l, a, b;
@@ -94,6 +97,11 @@ class LocalCheck {
     };
     bool clear_of_triangle(const Triangle& t, std::size_t k, std::size_t u,
                            const Overlay& ov) const;
+    /// clear_of_triangle() given the segment: from u to u2 at s0, s1; u2_is_last: u2 is the
+    /// last vertex of an open layer. `ov`: the overlay of a job (or none).
+    bool triangle_clear_of(const Triangle& t, std::size_t k, std::size_t u, std::size_t u2,
+                           bool u2_is_last, const Vec2& s0, const Vec2& s1,
+                           const Overlay* ov = nullptr) const;
     void changed_segments(std::size_t k, const Overlay& ov, std::vector<Vec2>& olds,
                           std::vector<Vec2>& news) const;
 

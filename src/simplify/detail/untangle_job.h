@@ -80,8 +80,8 @@ struct JobSlots {
 /// Where the checks read positions: the live polylines, or over a job's runs its work scene.
 class Overlay {
   public:
-    /// The live positions. near() marks the segments it meets (LivePolylines::segments_near).
-    explicit Overlay(LivePolylines& live) : live_(&live), marking_(&live) {}
+    /// The live positions.
+    explicit Overlay(const LivePolylines& live) : live_(&live) {}
     /// Over `job`'s runs, the positions of `work` (its work scene while it runs); `moving`:
     /// the job's moving segments where they are in `work` (filed with their boxes there).
     /// Writes nothing the live polylines share: the jobs of a batch run side by side.
@@ -102,17 +102,15 @@ class Overlay {
     template <class F>
     void near(const Box2& box, F&& f) const {
         if (!job_) {
-            marking_->segments_near(box, f);
+            live_->segments_near(box, f);
             return;
         }
         // The live grid holds the moving segments where they were: they come from `moving`.
-        live_->grid().query_once(
-            box, [&](SegRef s) { return live_->seg_box(s.layer, s.start); },
-            [&](SegRef s) {
-                if (!slots_->is_free(s.layer, s.start, *job_) &&
-                    !slots_->is_free(s.layer, live_->layer(s.layer).next[s.start], *job_))
-                    f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
-            });
+        live_->live_segments_near(box, [&](const LiveSegment& s) {
+            if (!slots_->is_free(s.layer, s.start, *job_) &&
+                !slots_->is_free(s.layer, s.end, *job_))
+                f(static_cast<std::size_t>(s.layer), static_cast<std::size_t>(s.start));
+        });
         moving_->query_once(
             box,
             [&](SegRef s) {
@@ -128,7 +126,6 @@ class Overlay {
 
   private:
     const LivePolylines* live_;
-    LivePolylines* marking_ = nullptr;  // without a job: the polylines near() marks
     const JobSlots* slots_ = nullptr;
     const Job* job_ = nullptr;
     const Scene* work_ = nullptr;
