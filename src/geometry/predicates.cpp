@@ -35,12 +35,8 @@ int detail::orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c) {
     return sign_of(acx * bcy - acy * bcx);
 }
 
-SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
-    // Quick reject on the bounding boxes (exact comparisons).
-    if (std::max(p0.x, p1.x) < std::min(q0.x, q1.x) ||
-        std::max(q0.x, q1.x) < std::min(p0.x, p1.x) ||
-        std::max(p0.y, p1.y) < std::min(q0.y, q1.y) || std::max(q0.y, q1.y) < std::min(p0.y, p1.y))
-        return SegmentContact::None;
+SegmentContact detail::segment_contact_in_boxes(const Vec2& p0, const Vec2& p1, const Vec2& q0,
+                                                const Vec2& q1) {
     const int o1 = orient2d(p0, p1, q0);
     const int o2 = orient2d(p0, p1, q1);
     if (o1 * o2 > 0) return SegmentContact::None;

@@ -6,6 +6,7 @@
 
 #include "strata/core/types.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -42,8 +43,23 @@ enum class SegmentContact {
     Touch,   ///< They share a point that is an end of one of them, or overlap collinearly.
 };
 
-/// Exact classification of segments [p0, p1] and [q0, q1].
-SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1);
+namespace detail {
+/// segment_contact() of segments whose boxes meet.
+SegmentContact segment_contact_in_boxes(const Vec2& p0, const Vec2& p1, const Vec2& q0,
+                                        const Vec2& q1);
+}  // namespace detail
+
+/// Exact classification of segments [p0, p1] and [q0, q1]. The box test is inline: most
+/// segments a caller asks about (near a move, in a grid cell) are apart.
+inline SegmentContact segment_contact(const Vec2& p0, const Vec2& p1, const Vec2& q0,
+                                      const Vec2& q1) {
+    // Quick reject on the bounding boxes (exact comparisons).
+    if (std::max(p0.x, p1.x) < std::min(q0.x, q1.x) ||
+        std::max(q0.x, q1.x) < std::min(p0.x, p1.x) ||
+        std::max(p0.y, p1.y) < std::min(q0.y, q1.y) || std::max(q0.y, q1.y) < std::min(p0.y, p1.y))
+        return SegmentContact::None;
+    return detail::segment_contact_in_boxes(p0, p1, q0, q1);
+}
 
 /// Contribution of the directed segment a -> b to the winding number of a closed polyline
 /// around p, by the crossing rule (the ray from p toward +x; each segment half-open in y):

@@ -482,13 +482,7 @@ class Finisher {
         auto is_mover = [&](std::size_t m, std::size_t k) {
             return m == l && (k == v || (has_prev && k == prev) || (has_next && k == next));
         };
-        // segment_contact()'s box test first, inline: most segments near a move miss it.
         auto meets = [](const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
-            if (std::max(a0.x, a1.x) < std::min(b0.x, b1.x) ||
-                std::max(b0.x, b1.x) < std::min(a0.x, a1.x) ||
-                std::max(a0.y, a1.y) < std::min(b0.y, b1.y) ||
-                std::max(b0.y, b1.y) < std::min(a0.y, a1.y))
-                return false;
             return segment_contact(a0, a1, b0, b1) != SegmentContact::None;
         };
         // The boxes of the triangles swept by the old segments.
