@@ -270,12 +270,16 @@ void validate(const UntangleParams& params) {
 
 namespace {
 
-// One untangling of the whole scene, by the outside sides of untangling_outside_sides() unless
-// params gives them; `keep_simple`: EngineSettings::keep_simple.
-UntangleReport untangle_once(Scene& scene, const UntangleParams& given, const ProgressFn& progress,
-                             bool keep_simple) {
+// `given`, with the outside sides of untangling_outside_sides(scene) unless it gives them.
+UntangleParams with_outside_sides(const Scene& scene, const UntangleParams& given) {
     UntangleParams params = given;
     if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
+    return params;
+}
+
+// One untangling of the whole scene; `keep_simple`: EngineSettings::keep_simple.
+UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const ProgressFn& progress,
+                             bool keep_simple) {
     UntangleReport report = run(scene, whole_scene_pieces(scene), params, progress, keep_simple);
     report.kept_simple = keep_simple;
     return report;
@@ -290,7 +294,8 @@ UntangleReport after(UntangleReport second, const UntangleReport& first) {
 
 }  // namespace
 
-UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
+UntangleReport untangle(Scene& scene, const UntangleParams& given, const ProgressFn& progress) {
+    const UntangleParams params = with_outside_sides(scene, given);
     const Scene input = scene;
     UntangleReport report = untangle_once(scene, params, progress, false);
     if (report.collision_free) return report;
@@ -310,9 +315,8 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
     InputSides inferred = infer_input_sides(scene);
-    UntangleParams with_sides = params;
-    with_sides.outside_sides =
-        params.outside_sides.empty() ? untangling_outside_sides(scene) : params.outside_sides;
+    const UntangleParams global = with_outside_sides(scene, params);
+    UntangleParams with_sides = global;
     with_sides.input_sides = &inferred;
     const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
     // By the inferred sides, then by the global order; the second tries (no self-crossing
@@ -322,35 +326,32 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     UntangleReport first;  // the global order's first try: the result when nothing is clean
     Scene first_scene;
     int passes = 0, rounds = 0;
-    for (bool keep_simple : {false, true}) {
-        if (rolled) {
-            Scene attempt = input;
-            UntangleReport report = untangle_once(attempt, with_sides, progress, keep_simple);
-            passes += report.passes;
-            rounds += report.rounds;
-            if (report.collision_free) {
-                report.inferred_sides = true;
-                report.passes = passes;
-                report.rounds = rounds;
-                scene = std::move(attempt);
-                if (kept) *kept = std::move(inferred);
-                return report;
-            }
-        }
-        Scene attempt = input;
-        UntangleReport report = untangle_once(attempt, params, progress, keep_simple);
+    // One try from the input into `attempt`; true when it comes out clean.
+    auto clean_try = [&](const UntangleParams& p, bool keep_simple, Scene& attempt,
+                         UntangleReport& report) {
+        attempt = input;
+        report = untangle_once(attempt, p, progress, keep_simple);
         passes += report.passes;
         rounds += report.rounds;
-        if (report.collision_free) {
-            report.passes = passes;
-            report.rounds = rounds;
-            scene = std::move(attempt);
-            return report;
+        return report.collision_free;
+    };
+    for (bool keep_simple : {false, true}) {
+        Scene attempt;
+        UntangleReport report;
+        if (rolled && clean_try(with_sides, keep_simple, attempt, report)) {
+            report.inferred_sides = true;
+            if (kept) *kept = std::move(inferred);
+        } else if (!clean_try(global, keep_simple, attempt, report)) {
+            if (!keep_simple) {
+                first = report;
+                first_scene = std::move(attempt);
+            }
+            continue;
         }
-        if (!keep_simple) {
-            first = report;
-            first_scene = std::move(attempt);
-        }
+        report.passes = passes;
+        report.rounds = rounds;
+        scene = std::move(attempt);
+        return report;
     }
     scene = std::move(first_scene);
     return first;
