@@ -54,7 +54,62 @@ bool meets(const Vec2& p, const Vec2& q, const Layer& b) {
 
 }  // namespace
 
+namespace {
+
+// A region of InputSides::by_region(): `count` consecutive vertices of a layer from `first`
+// (wrapping around a closed layer), with `plus` and `minus` of them recorded on each side.
+struct Region {
+    std::size_t first = 0, count = 0, plus = 0, minus = 0;
+};
+
+// The regions of the vertices of `layer` with a side of layer `other` (`s`: their recorded
+// codes, kBeyondEnd or 0 for none), as InputSides::by_region() documents them.
+std::vector<Region> regions_of(const Layer& layer, const Layer& other,
+                               const std::vector<signed char>& s) {
+    const std::size_t n = s.size();
+    auto has_side = [&](std::size_t k) { return s[k] == 1 || s[k] == -1; };
+    // joins[k]: vertex k and the next one are in one region.
+    std::vector<char> joins(n, 0);
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t next = k + 1 < n ? k + 1 : 0;
+        if ((next == 0 && !layer.closed) || !has_side(k) || !has_side(next)) continue;
+        joins[k] = s[k] == s[next] || meets(layer.points[k], layer.points[next], other);
+    }
+    // Start where a region starts (a closed layer's regions may wrap around).
+    std::size_t start = 0;
+    if (layer.closed) {
+        while (start < n && joins[(start + n - 1) % n]) ++start;
+        if (start == n) start = 0;  // one region around the whole loop
+    }
+    std::vector<Region> out;
+    for (std::size_t i = 0; i < n;) {
+        Region r;
+        r.first = (start + i) % n;
+        r.count = 1;
+        while (i + r.count < n && joins[(r.first + r.count - 1) % n]) ++r.count;
+        if (has_side(r.first)) {
+            for (std::size_t c = 0; c < r.count; ++c)
+                (s[(r.first + c) % n] > 0 ? r.plus : r.minus)++;
+            out.push_back(r);
+        }
+        i += r.count;
+    }
+    return out;
+}
+
+// The majority's side of `r` (0 on a tie).
+signed char majority(const Region& r) {
+    return static_cast<signed char>(r.plus > r.minus ? 1 : (r.plus < r.minus ? -1 : 0));
+}
+
+}  // namespace
+
 InputSides InputSides::by_region(const Scene& scene) const {
+    return from_codes(scene, region_codes(scene, nullptr));
+}
+
+std::vector<std::vector<signed char>> InputSides::region_codes(
+    const Scene& scene, std::vector<Alternative>* split) const {
     if (n_ != scene.size())
         throw InvalidInput("input sides: by_region() got a scene of " +
                            std::to_string(scene.size()) + " layers for " + std::to_string(n_));
@@ -74,35 +129,70 @@ InputSides InputSides::by_region(const Scene& scene) const {
                 s.clear();
                 continue;
             }
-            auto has_side = [&](std::size_t k) { return s[k] == 1 || s[k] == -1; };
-            // joins[k]: vertex k and the next one are in one region.
-            std::vector<char> joins(n, 0);
-            for (std::size_t k = 0; k < n; ++k) {
-                const std::size_t next = k + 1 < n ? k + 1 : 0;
-                if ((next == 0 && !layer.closed) || !has_side(k) || !has_side(next)) continue;
-                joins[k] =
-                    s[k] == s[next] || meets(layer.points[k], layer.points[next], scene.layer(b));
-            }
-            // Start where a region starts (a closed layer's regions may wrap around).
-            std::size_t start = 0;
-            if (layer.closed) {
-                while (start < n && joins[(start + n - 1) % n]) ++start;
-                if (start == n) start = 0;  // one region around the whole loop
-            }
-            for (std::size_t i = 0; i < n;) {
-                const std::size_t first = (start + i) % n;
-                std::size_t count = 1;
-                while (i + count < n && joins[(first + count - 1) % n]) ++count;
-                if (has_side(first)) {
-                    int votes = 0;
-                    for (std::size_t c = 0; c < count; ++c) votes += s[(first + c) % n];
-                    const signed char side = votes > 0 ? 1 : (votes < 0 ? -1 : 0);
-                    for (std::size_t c = 0; c < count; ++c) s[(first + c) % n] = side;
+            const std::vector<signed char> recorded = s;
+            for (const Region& r : regions_of(layer, scene.layer(b), recorded)) {
+                const signed char side = majority(r);
+                for (std::size_t c = 0; c < r.count; ++c) s[(r.first + c) % n] = side;
+                if (!split || r.plus == 0 || r.minus == 0) continue;
+                // The region read otherwise: an open layer's region split in two where the
+                // two runs fit the recorded sides best, if that fits better than one side.
+                const std::size_t one = std::max(r.plus, r.minus);
+                std::size_t best = one, cut = 0;
+                signed char before = 0, after = 0;
+                if (!layer.closed) {
+                    Region head, tail = r;
+                    for (std::size_t c = 1; c < r.count; ++c) {
+                        const bool plus = recorded[r.first + c - 1] > 0;
+                        ++(plus ? head.plus : head.minus);
+                        --(plus ? tail.plus : tail.minus);
+                        const signed char h = majority(head), t = majority(tail);
+                        const std::size_t fit =
+                            std::max(head.plus, head.minus) + std::max(tail.plus, tail.minus);
+                        if (h != 0 && t != 0 && h != t && fit > best) {
+                            best = fit;
+                            cut = c;
+                            before = h;
+                            after = t;
+                        }
+                    }
                 }
-                i += count;
+                auto add = [&](std::size_t fit, auto side_at) {
+                    Alternative alt;
+                    alt.pair = a * n_ + b;
+                    alt.first = r.first;
+                    alt.score = (static_cast<double>(fit) - static_cast<double>(one)) /
+                                static_cast<double>(r.count);
+                    for (std::size_t c = 0; c < r.count; ++c) alt.sides.push_back(side_at(c));
+                    split->push_back(std::move(alt));
+                };
+                if (cut > 0)
+                    add(best, [&](std::size_t c) { return c < cut ? before : after; });
+                else if (side != 0)  // otherwise the minority's side
+                    add(std::min(r.plus, r.minus),
+                        [&](std::size_t) { return static_cast<signed char>(-side); });
+                else
+                    for (const int either : {1, -1})
+                        add(one, [&](std::size_t) { return static_cast<signed char>(either); });
             }
         }
-    return from_codes(scene, std::move(codes));
+    return codes;
+}
+
+std::vector<InputSides> InputSides::region_alternatives(const Scene& scene) const {
+    std::vector<Alternative> alternatives;
+    const std::vector<std::vector<signed char>> codes = region_codes(scene, &alternatives);
+    std::stable_sort(alternatives.begin(), alternatives.end(),
+                     [](const Alternative& x, const Alternative& y) { return x.score > y.score; });
+    std::vector<InputSides> out;
+    out.reserve(alternatives.size());
+    for (const Alternative& alt : alternatives) {
+        std::vector<std::vector<signed char>> changed = codes;
+        std::vector<signed char>& s = changed[alt.pair];
+        for (std::size_t c = 0; c < alt.sides.size(); ++c)
+            s[(alt.first + c) % s.size()] = alt.sides[c];
+        out.push_back(from_codes(scene, std::move(changed)));
+    }
+    return out;
 }
 
 InputSides infer_input_sides(const Scene& scene, const InputSideParams& params) {

@@ -314,7 +314,8 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         return untangle(scene, params, progress);
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
-    InputSides inferred = infer_input_sides(scene);
+    const InputSides recorded = record_input_sides(scene);
+    InputSides inferred = recorded.by_region(scene);
     const UntangleParams global = with_outside_sides(scene, params);
     UntangleParams with_sides = global;
     with_sides.input_sides = &inferred;
@@ -352,6 +353,37 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         report.rounds = rounds;
         scene = std::move(attempt);
         return report;
+    }
+    // Neither is clean: the other readings of the regions whose recorded sides disagree
+    // (InputSides::region_alternatives(), at most kAlternatives of them, best fitting first),
+    // each tried once, then once more without self-crossings made (as above); of the clean
+    // results of the first round that has one, the one that moves the input least.
+    constexpr std::size_t kAlternatives = 8;
+    std::vector<InputSides> others = recorded.region_alternatives(scene);
+    if (others.size() > kAlternatives) others.resize(kAlternatives);
+    for (bool keep_simple : {false, true}) {
+        std::size_t best = others.size();
+        Scene best_scene;
+        UntangleReport best_report;
+        for (std::size_t i = 0; i < others.size(); ++i) {
+            UntangleParams p = global;
+            p.input_sides = &others[i];
+            Scene attempt;
+            UntangleReport report;
+            if (!clean_try(p, keep_simple, attempt, report) ||
+                (best < others.size() && report.max_displacement >= best_report.max_displacement))
+                continue;
+            best = i;
+            best_scene = std::move(attempt);
+            best_report = report;
+        }
+        if (best == others.size()) continue;
+        best_report.inferred_sides = true;
+        best_report.passes = passes;
+        best_report.rounds = rounds;
+        if (kept) *kept = std::move(others[best]);
+        scene = std::move(best_scene);
+        return best_report;
     }
     scene = std::move(first_scene);
     return first;

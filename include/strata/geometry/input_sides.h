@@ -72,6 +72,15 @@ class InputSides {
     /// side without meeting b goes around b's end and starts another region (a roll). Every
     /// vertex of a region takes the side of the majority of its vertices (a tie: no side).
     InputSides by_region(const Scene& scene) const;
+    /// Other readings of the sides by_region(scene) infers, for when the untangling by those
+    /// is not clean: one per region whose vertices' recorded sides disagree, each the sides of
+    /// by_region() with that one region read otherwise. A region of an open layer whose
+    /// recorded sides two runs fit better than one side (the most vertices agreeing, e.g. a
+    /// roll whose bend the decimation cut across the other layer, which by_region() takes for
+    /// a tangle) is split in two there; any other takes its minority's side (both sides on a
+    /// tie). Ordered by the share of the region's vertices the reading agrees with, less the
+    /// majority's share, highest first (a split first, then the closest votes).
+    std::vector<InputSides> region_alternatives(const Scene& scene) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
     /// outside_side() per layer of `scene`, the scene these sides are for): the rolled or
     /// folded-over vertices, once per other layer. Finds the side of every vertex.
@@ -88,6 +97,16 @@ class InputSides {
     /// Sides for `scene` given as codes: codes[a * n + b][k] for vertex k of layer a against
     /// layer b (empty: none). Defined in checks.cpp.
     static InputSides from_codes(const Scene& scene, std::vector<std::vector<signed char>> codes);
+    /// One other reading of a region (region_alternatives()): pair a * n + b, the region's
+    /// first vertex, its vertices' sides, and the agreement score it is ordered by.
+    struct Alternative {
+        std::size_t pair = 0, first = 0;
+        std::vector<signed char> sides;
+        double score = 0.0;
+    };
+    /// The codes of by_region(scene); with `split`, the other readings of its regions too.
+    std::vector<std::vector<signed char>> region_codes(const Scene& scene,
+                                                       std::vector<Alternative>* split) const;
     friend InputSides record_input_sides(const Scene&, const InputSideParams&);
 
     static constexpr std::size_t kNoLayer = static_cast<std::size_t>(-1);

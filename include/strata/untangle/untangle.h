@@ -166,8 +166,13 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// (a part rolled or folded over an open layer, which the global order pushes back), by the
 /// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
 /// rolled; that result is kept when it is clean against those sides (report.inferred_sides).
-/// Otherwise, or when it is not clean, by the global order (untangle() from the input). With
-/// params.input_sides given, this is untangle(). Same params, progress and throws as
+/// Otherwise, or when it is not clean, by the global order (untangle() from the input). When
+/// neither is clean, by each of the first 8 other readings of the inferred regions
+/// (InputSides::region_alternatives() of the input's recorded sides: a region whose vertices'
+/// sides disagree, split in two or given its minority's side), first as untangle()'s first
+/// try, then as its second; the first round with a clean result keeps the clean one that moves
+/// a vertex least (report.inferred_sides, `kept` those sides). With params.input_sides given,
+/// this is untangle(). Same params, progress and throws as
 /// untangle(). `kept`: if given, receives the inferred sides when they were kept, for judging
 /// the result (check_scene() with them and params' outside sides, or outside_sides() of the
 /// input); left alone otherwise.
