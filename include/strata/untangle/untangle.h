@@ -167,7 +167,7 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
 /// rolled; that result is kept when it is clean against those sides (report.inferred_sides).
 /// Otherwise, or when it is not clean, by the global order (untangle() from the input). When
-/// neither is clean, by each of the first 8 other readings of the inferred regions
+/// neither is clean, by each of the first 4 other readings of the inferred regions
 /// (InputSides::region_alternatives() of the input's recorded sides: a region whose vertices'
 /// sides disagree, split in two or given its minority's side), first as untangle()'s first
 /// try, then as its second; the first round with a clean result keeps the clean one that moves
