@@ -4,6 +4,8 @@
 #include "strata/core/format.h"
 #include "strata/geometry/predicates.h"
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -102,6 +104,40 @@ signed char majority(const Region& r) {
     return static_cast<signed char>(r.plus > r.minus ? 1 : (r.plus < r.minus ? -1 : 0));
 }
 
+// The side of open layer `other` that the centroid of closed `layer`'s vertices lies on, by
+// the rule of record_input_sides() (the side at the closest point; at a corner, the side of
+// the corner's wedge); 0 when the closest point is an end point of `other`.
+signed char centroid_side(const Layer& layer, const Layer& other) {
+    Vec2 centre(0.0);
+    for (const Vec2& p : layer.points) centre += p;
+    centre /= static_cast<double>(layer.points.size());
+    const std::vector<Vec2>& q = other.points;
+    double best = -1.0, at = 0.0;
+    std::size_t segment = 0;
+    for (std::size_t j = 0; j + 1 < q.size(); ++j) {
+        const Vec2 d = q[j + 1] - q[j];
+        const double len2 = glm::dot(d, d);
+        const double t = len2 > 0.0 ? std::clamp(glm::dot(centre - q[j], d) / len2, 0.0, 1.0) : 0.0;
+        const Vec2 c = q[j] + t * d;
+        const double dist2 = glm::dot(centre - c, centre - c);
+        if (best < 0.0 || dist2 < best) {
+            best = dist2;
+            segment = j;
+            at = t;
+        }
+    }
+    if (best < 0.0 || (segment == 0 && at <= 0.0) || (segment + 2 == q.size() && at >= 1.0))
+        return 0;
+    int side = 0;
+    if (at >= 1.0)
+        side = corner_side(q[segment], q[segment + 1], q[segment + 2], centre);
+    else if (at <= 0.0)
+        side = corner_side(q[segment - 1], q[segment], q[segment + 1], centre);
+    else
+        side = segment_side(q[segment], q[segment + 1], centre);
+    return static_cast<signed char>(side);
+}
+
 }  // namespace
 
 InputSides InputSides::by_region(const Scene& scene) const {
@@ -131,7 +167,15 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
             }
             const std::vector<signed char> recorded = s;
             for (const Region& r : regions_of(layer, scene.layer(b), recorded)) {
-                const signed char side = majority(r);
+                signed char side = majority(r);
+                // A closed layer all of whose vertices form one region (a loop within reach
+                // of the other layer, e.g. a cord in a fold) and whose vertices disagree: the
+                // side its shape lies on (its vertex centroid's), not its vertices' vote.
+                if (layer.closed && r.count == n && r.plus > 0 && r.minus > 0 &&
+                    !scene.layer(b).closed) {
+                    const signed char bulk = centroid_side(layer, scene.layer(b));
+                    if (bulk != 0) side = bulk;
+                }
                 for (std::size_t c = 0; c < r.count; ++c) s[(r.first + c) % n] = side;
                 if (!split || r.plus == 0 || r.minus == 0) continue;
                 // The region read otherwise: an open layer's region split in two where the
@@ -160,15 +204,17 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     Alternative alt;
                     alt.pair = a * n_ + b;
                     alt.first = r.first;
-                    alt.score = (static_cast<double>(fit) - static_cast<double>(one)) /
+                    const std::size_t kept =
+                        side > 0 ? r.plus : (side < 0 ? r.minus : std::max(r.plus, r.minus));
+                    alt.score = (static_cast<double>(fit) - static_cast<double>(kept)) /
                                 static_cast<double>(r.count);
                     for (std::size_t c = 0; c < r.count; ++c) alt.sides.push_back(side_at(c));
                     split->push_back(std::move(alt));
                 };
                 if (cut > 0)
                     add(best, [&](std::size_t c) { return c < cut ? before : after; });
-                else if (side != 0)  // otherwise the minority's side
-                    add(std::min(r.plus, r.minus),
+                else if (side != 0)  // otherwise the other side
+                    add(side > 0 ? r.minus : r.plus,
                         [&](std::size_t) { return static_cast<signed char>(-side); });
                 else
                     for (const int either : {1, -1})

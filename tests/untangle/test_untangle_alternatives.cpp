@@ -72,6 +72,57 @@ TEST_CASE("region_alternatives: none where every region's vertices agree", "[unt
     CHECK(record_input_sides(stack).region_alternatives(stack).empty());
 }
 
+TEST_CASE("by_region: a closed loop within reach takes the side of its bulk, not its vote",
+          "[untangle][sides]") {
+    // b: a straight open layer along y = 0 (its right side, +1, is y < 0). a: a closed loop
+    // crossing it, three vertices a hair below it and two well above: one region (its sides
+    // change across b), whose vertices vote +1 and whose centroid lies above (-1).
+    Layer a;
+    a.name = "a";
+    a.closed = true;
+    a.points = {{3.0, -0.02}, {5.0, -0.02}, {7.0, -0.02}, {7.0, 1.0}, {3.0, 1.0}};
+    Layer b;
+    b.name = "b";
+    b.points = {{0.0, 0.0}, {2.0, 0.0}, {4.0, 0.0}, {6.0, 0.0}, {8.0, 0.0}, {10.0, 0.0}};
+    const Scene scene({a, b});
+    const InputSides recorded = record_input_sides(scene);
+    REQUIRE(sides_of(recorded, scene, 0, 1) == "+++--");
+    CHECK(sides_of(recorded.by_region(scene), scene, 0, 1) == "-----");
+    // The other reading: the other side.
+    const std::vector<InputSides> others = recorded.region_alternatives(scene);
+    REQUIRE(others.size() == 1);
+    CHECK(sides_of(others.front(), scene, 0, 1) == "+++++");
+}
+
+TEST_CASE("untangle_inferring_sides keeps a cord in its collar's fold (its bulk's side)",
+          "[untangle][rolled]") {
+    // Out-of-sample decimations of the collar (seeds 6 and 10 at 95%) whose cord's vertices
+    // mostly lie on the unrolled side of the collar (+-+-- and +---+ where the original has
+    // +++++): clean by those sides, and not by the original's, before.
+    const Scene input = make_scene(SceneFamily::CollarWrap);
+    for (unsigned seed : {6u, 10u}) {
+        INFO("seed " << seed);
+        SimplifyParams naive;
+        naive.decimator = "random";
+        naive.remove = 0.95;
+        naive.untangle = false;
+        naive.seed = seed;
+        Scene tangled = input;
+        simplify(tangled, naive);
+        const InputSides sides = InputSides::matched(record_input_sides(input), input, tangled);
+        CheckParams scoring;
+        scoring.outside_sides = outside_sides(input);
+        scoring.input_sides = &sides;
+        REQUIRE(check_scene(tangled, scoring).crossing_count > 0);
+        Scene out = tangled;
+        const UntangleReport report = untangle_inferring_sides(out);
+        CHECK(report.collision_free);
+        const CheckReport check = check_scene(out, scoring);
+        CHECK(check.is_collision_free());
+        CHECK(check.nesting_violation_count == 0);  // the cord kept in the fold
+    }
+}
+
 TEST_CASE("untangle_inferring_sides keeps a roll whose bend the decimation cut",
           "[untangle][rolled]") {
     // strata_bench_untangle's cases that were not clean by the inferred sides nor by the global

@@ -70,16 +70,19 @@ class InputSides {
     /// layer b fall into regions, runs of consecutive vertices joined by a segment that keeps
     /// its side or crosses b (a tangle: one end is on the wrong side); a segment that changes
     /// side without meeting b goes around b's end and starts another region (a roll). Every
-    /// vertex of a region takes the side of the majority of its vertices (a tie: no side).
+    /// vertex of a region takes the side of the majority of its vertices (a tie: no side),
+    /// except that a closed layer whose vertices all form one region and disagree (a loop all
+    /// within reach of b, e.g. a cord in a fold of b) takes the side of its vertex centroid
+    /// (its bulk), when that side is defined (the centroid's closest point on b not an end).
     InputSides by_region(const Scene& scene) const;
     /// Other readings of the sides by_region(scene) infers, for when the untangling by those
     /// is not clean: one per region whose vertices' recorded sides disagree, each the sides of
     /// by_region() with that one region read otherwise. A region of an open layer whose
     /// recorded sides two runs fit better than one side (the most vertices agreeing, e.g. a
     /// roll whose bend the decimation cut across the other layer, which by_region() takes for
-    /// a tangle) is split in two there; any other takes its minority's side (both sides on a
-    /// tie). Ordered by the share of the region's vertices the reading agrees with, less the
-    /// majority's share, highest first (a split first, then the closest votes).
+    /// a tangle) is split in two there; any other takes the side by_region() did not give it
+    /// (both sides on a tie). Ordered by the share of the region's vertices the reading agrees
+    /// with, less the majority's share, highest first (a split first, then the closest votes).
     std::vector<InputSides> region_alternatives(const Scene& scene) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
     /// outside_side() per layer of `scene`, the scene these sides are for): the rolled or
