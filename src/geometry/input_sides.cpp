@@ -54,10 +54,6 @@ bool meets(const Vec2& p, const Vec2& q, const Layer& b) {
     return false;
 }
 
-}  // namespace
-
-namespace {
-
 // A region of InputSides::by_region(): `count` consecutive vertices of a layer from `first`
 // (wrapping around a closed layer), with `plus` and `minus` of them recorded on each side.
 struct Region {

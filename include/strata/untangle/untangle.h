@@ -169,7 +169,7 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// Otherwise, or when it is not clean, by the global order (untangle() from the input). When
 /// neither is clean, by each of the first 4 other readings of the inferred regions
 /// (InputSides::region_alternatives() of the input's recorded sides: a region whose vertices'
-/// sides disagree, split in two or given its minority's side), first as untangle()'s first
+/// sides disagree, split in two or given the other side), first as untangle()'s first
 /// try, then as its second; the first round with a clean result keeps the clean one that moves
 /// a vertex least (report.inferred_sides, `kept` those sides). With params.input_sides given,
 /// this is untangle(). Same params, progress and throws as
