@@ -51,7 +51,7 @@ Run add_untangle_command(CLI::App& app) {
                     "keeps the side of the open layers it has there (a rolled or folded-over "
                     "part stays so); without it, the sides inferred per region (as --infer-sides) "
                     "where the input has rolled regions and that comes out clean, else the global "
-                    "order");
+                    "order, else the clean other reading of those regions that moves least");
     cmd->add_flag("--infer-sides", opt->infer_sides,
                   "Without the original: take the sides of the open layers from the input "
                   "itself, each region of a layer on the side most of its vertices are (a "
@@ -162,7 +162,8 @@ Run add_untangle_command(CLI::App& app) {
             if (params.input_sides)
                 j["sides"] = {{"from", reference ? opt->reference : "inferred"},
                               {"rolled_vertices", r.rolled_vertices},
-                              {"rolled_kept", r.rolled_kept}};
+                              {"rolled_kept", r.rolled_kept},
+                              {"reading", r.sides_reading}};
             write_file_atomic(opt->report, j.dump(2) + "\n");
         }
         std::printf("%s -> %s: %zu layers, %zu vertices\n", opt->input.c_str(), opt->output.c_str(),
@@ -170,13 +171,22 @@ Run add_untangle_command(CLI::App& app) {
         std::printf(
             "crossings between layers: %zu before, %zu after; nesting violations after: %zu\n",
             r.crossings_before, r.crossings_after, after.nesting_violation_count);
-        if (params.input_sides)
+        if (params.input_sides) {
+            std::string why;
+            if (r.sides_reading > 0)
+                why =
+                    " (neither the input's rolled regions as inferred nor the global order "
+                    "came out clean: kept another reading of those regions, number " +
+                    std::to_string(r.sides_reading) + ", the clean one that moved least)";
+            else if (r.inferred_sides)
+                why = " (the input has rolled regions)";
             std::printf(
                 "sides %s %s: %zu vertices on a rolled side (the other side of an open layer "
                 "than the global order), %zu kept it%s\n",
                 reference ? "from" : "inferred from",
                 reference ? opt->reference.c_str() : opt->input.c_str(), r.rolled_vertices,
-                r.rolled_kept, r.inferred_sides ? " (the input has rolled regions)" : "");
+                r.rolled_kept, why.c_str());
+        }
         std::printf(
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
             "%.4g\n",

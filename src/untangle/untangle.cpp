@@ -380,6 +380,7 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         }
         if (best == others.size()) continue;
         best_report.inferred_sides = true;
+        best_report.sides_reading = best + 1;
         best_report.passes = passes;
         best_report.rounds = rounds;
         if (kept) *kept = std::move(others[best]);

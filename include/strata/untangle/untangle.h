@@ -129,6 +129,10 @@ struct UntangleReport {
     /// untangle_inferring_sides(): the result kept the sides inferred per region of the input
     /// (infer_input_sides()), which has rolled regions.
     bool inferred_sides = false;
+    /// With inferred_sides: 0 when the kept sides are the input's regions as inferred
+    /// (InputSides::by_region()); i > 0 when neither those nor the global order came out clean
+    /// and the kept sides are the i-th other reading (InputSides::region_alternatives()).
+    std::size_t sides_reading = 0;
     /// untangle(): the first try did not come out clean, and the result is the second, from
     /// the input, in which no vertex move makes a self-crossing (passes and rounds count both).
     bool kept_simple = false;
