@@ -749,11 +749,15 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         result.ok = is_ok(work);
         result.seconds_check += seconds_since(begin);
     };
+    // The last run of the finishing stage left a close vertex on the wrong side of another
+    // layer (true when the stage is off: nothing tells).
+    bool wrong_side = true;
     auto finish_and_check = [&](bool only_when_untangled) {
         if (params.finish_separations) {
             const auto begin = Clock::now();
             finish.only_when_untangled = only_when_untangled;
             const SeparationResult f = finish_separations(work, pieces, relations, finish);
+            wrong_side = f.wrong_side > 0;
             ++result.finishes;
             result.finish_moves += f.moves;
             result.seconds_finish += seconds_since(begin);
@@ -770,7 +774,8 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     // rebuild and, for the grid, recomputes only the leaves near the moves).
     std::optional<SceneFields> built;
     std::vector<std::vector<Vec2>> built_points;
-    std::vector<double> worst;  // give_up_when_stalled: worst violation at each pass's start
+    const bool give_up = params.give_up_when_stalled || settings.give_up_when_stalled;
+    std::vector<double> worst;  // give_up: worst violation at each pass's start
     for (int pass = 0; pass < params.max_passes && !result.ok && !result.gave_up; ++pass) {
         ++result.passes;
         start = Clock::now();
@@ -819,9 +824,13 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
                     finish_and_check(true);
                     start = Clock::now();
                 }
-                if (params.give_up_when_stalled && round == 0 && s == 0 && !result.ok) {
+                if (give_up && round == 0 && s == 0 && !result.ok) {
                     worst.push_back(engine.max_violation());
-                    if (is_stalled(worst, params.max_passes, engine.slack())) {
+                    // EngineSettings::give_up_when_stalled: only while the finishing stage
+                    // still finds a close vertex on the wrong side (a tangle the projection
+                    // does not take out), not for gaps still short.
+                    if ((params.give_up_when_stalled || wrong_side) &&
+                        is_stalled(worst, params.max_passes, engine.slack())) {
                         result.gave_up = true;
                         break;
                     }

@@ -89,6 +89,13 @@ struct EngineSettings {
     /// order): no self-crossing is made. untangle() only; the driver's untanglings (which
     /// check a region, whole layers being long) leave it off.
     bool keep_simple = false;
+    /// Gives up on a stalled run as UntangleParams::give_up_when_stalled does (from the fifth
+    /// pass, the same extrapolation), whatever the params say, but only while the last run of
+    /// the finishing stage left a close vertex on the wrong side of another layer (a tangle
+    /// that the projection does not take out; not gaps still short). The driver sets it for
+    /// the jobs that hold a rolled vertex (a Flipped local side, RelationSource::local_sides),
+    /// see JobRunner::local_sides().
+    bool give_up_when_stalled = false;
 };
 
 /// What run_engine() did.
