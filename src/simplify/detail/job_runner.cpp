@@ -198,19 +198,24 @@ JobRunner::Prepared JobRunner::prepare(Job& job, const std::vector<Job>& waiting
 // job has no such vertex.
 //
 // A job that holds a rolled vertex (a Flipped side) gives up when stalled with a close vertex
-// still on the wrong side (EngineSettings::give_up_when_stalled, from its fifth pass): there
-// four layers can stack (a shirt rolled over a jacket's end on a body: body, shirt, jacket,
-// roll), and the untanglings that fail ran all 16 passes at 2-3x the cost of a pass of the
-// unrolled scene (docs/untangle.md, *Rolled families, measured*). Jobs without one run as
-// before, so scenes without rolls keep their outputs.
+// still on the wrong side (EngineSettings::give_up_when_stalled, from its fifth pass), and its
+// finishing stage stops pushing after a sweep that leaves as many close vertices on the wrong
+// side as it found (EngineSettings::finish_stop_when_wrong_stays): there four layers can stack
+// (a shirt rolled over a jacket's end on a body: body, shirt, jacket, roll), and the
+// untanglings that fail ran all 16 passes at 2-3x the cost of a pass of the unrolled scene,
+// most of it in sweeps that pushed the same vertices back and forth (docs/untangle.md,
+// *Rolled families, measured*). Jobs without one run as before, so scenes without rolls keep
+// their outputs.
 void JobRunner::local_sides(Job& job) const {
     take_input_sides(job.relations, *job.work, sides_, settings_.outside_signs,
                      [&job](std::size_t r, std::size_t k) { return job.runs[r].ids[k]; });
     for (const auto& layer : job.relations.local_sides)
         for (const auto& vertex : layer)
             for (const RelationSource::LocalSide& x : vertex)
-                if (x.side == RelationSource::Side::Flipped)
+                if (x.side == RelationSource::Side::Flipped) {
                     job.settings.give_up_when_stalled = true;
+                    job.settings.finish_stop_when_wrong_stays = 1;
+                }
 }
 
 void JobRunner::execute(Job& job) const {

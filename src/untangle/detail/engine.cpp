@@ -744,6 +744,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     SeparationParams finish;
     finish.min_separation = settings.min_separation;
     finish.outside_signs = &settings.outside_signs;
+    finish.stop_when_wrong_stays = settings.finish_stop_when_wrong_stays;
     auto check = [&] {
         const auto begin = Clock::now();
         result.ok = is_ok(work);

@@ -96,6 +96,9 @@ struct EngineSettings {
     /// the jobs that hold a rolled vertex (a Flipped local side, RelationSource::local_sides),
     /// see JobRunner::local_sides().
     bool give_up_when_stalled = false;
+    /// SeparationParams::stop_when_wrong_stays of the finishing stage (0: the sweeps run until
+    /// they stall). The driver sets 1 for the jobs that hold a rolled vertex.
+    int finish_stop_when_wrong_stays = 0;
 };
 
 /// What run_engine() did.

@@ -238,6 +238,9 @@ class Finisher {
             result.worst = worst_;
             result.wrong_side = wrong_side_;
             if (worst_ <= params_.tolerance) break;
+            if (params_.stop_when_wrong_stays > 0 && wrong_side_ > 0 &&
+                wrong_side_ >= wrong_before && result.sweeps >= params_.stop_when_wrong_stays)
+                break;
             // Constraints that fight each other (a vertex squeezed between fixed ones) stop
             // improving: give up after 5 sweeps without a 1% gain.
             stalled = worst_ < 0.99 * previous ? 0 : stalled + 1;

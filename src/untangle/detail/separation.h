@@ -40,6 +40,11 @@ struct SeparationParams {
     /// Leave the scene as it is when a close vertex lies on the wrong side of another layer
     /// (a tangle the projection has yet to take out): the run then costs one measuring sweep.
     bool only_when_untangled = false;
+    /// Stop the sweeps once this many have run and the last left at least as many close
+    /// vertices on the wrong side of another layer as the run found (a tangle that pushing
+    /// does not take out: the projection has to); 0: never. The simplification driver's jobs
+    /// with rolled vertices use 1 (EngineSettings::finish_stop_when_wrong_stays).
+    int stop_when_wrong_stays = 0;
     /// Outside side of each work layer (+1: on the right of its direction of travel), see
     /// outside_side(); it says on which side of another layer a vertex belongs.
     const std::vector<int>* outside_signs = nullptr;
