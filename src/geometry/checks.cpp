@@ -491,6 +491,30 @@ Crossing to_crossing(const Contact& c) {
     return x;
 }
 
+// The partition behind RegionCheck: what may change when only vertices inside `box` move
+// (and their segments stay inside it), measured on the reference scene.
+struct RegionPlan {
+    Box2 box;
+    /// How far a change inside the box is seen: max(near distance, the largest separation
+    /// threshold), scene units.
+    double reach = 0.0;
+    /// Per layer and vertex: the reference position lies within `reach` of the box. The
+    /// separations and the nesting of the other vertices do not change.
+    std::vector<std::vector<char>> near_vertex;
+    /// Per layer and segment: its reference box meets the box. A contact with a segment that
+    /// does not, or a touch whose point lies outside the box, does not change.
+    std::vector<std::vector<char>> near_segment;
+};
+
+// What check_scene() of the reference found away from the region of a RegionPlan: the same in
+// every scene that differs from it only inside the region.
+struct Away {
+    std::size_t crossings = 0, touches = 0, self_crossings = 0;
+    std::size_t separation_violations = 0, nesting_violations = 0;
+    std::vector<char> met;    // met[a * n + b], a < b: the layers meet away from the region
+    std::vector<double> gap;  // gap[a * n + b], a < b: over the vertices away from the region
+};
+
 class Checker {
   public:
     Checker(const Scene& scene, const CheckParams& params) : scene_(scene), params_(params) {
@@ -516,12 +540,82 @@ class Checker {
         return std::move(report_);
     }
 
+    /// run(), also filling `away` with what lies away from plan's region (see Away).
+    CheckReport run(const RegionPlan& plan, Away& away) {
+        plan_ = &plan;
+        away_ = &away;
+        away.met.assign(n_ * n_, 0);
+        away.gap.assign(n_ * n_, kInf);
+        return run();
+    }
+
+    /// The counts of run() from `away` (of the reference) and the contacts, separations and
+    /// nesting near plan's region, which are checked here (RegionCheck::check()).
+    CheckCounts run_region(const RegionPlan& plan, const Away& away);
+
+  private:
+    // run_region(): the vertices of layer `from` near plan's region against layer `to`: their
+    // smallest distance below the cutoff into `gap` (pruned as scan_pair() prunes, from
+    // `met` and the reference's `away_gap`), their separation and nesting violations.
+    void scan_near_region(const RegionPlan& plan, const std::vector<char>& met,
+                          const std::vector<double>& away_gap, std::size_t from, std::size_t to,
+                          double& gap, std::size_t& separations, std::size_t& nesting) const {
+        const double near = report_.near_distance;
+        const std::size_t pair = std::min(from, to) * n_ + std::max(from, to);
+        const double required = scene_.required_separation(from, to);
+        const double threshold = required * (1.0 - params_.separation_tolerance);
+        const double cutoff = std::max(near, threshold);
+        const bool scanned = bounds_[from].inflated(cutoff).overlaps(bounds_[to]);
+        const bool sides = sides_by_nearest(from, to);
+        const bool closed = scene_.layer(to).closed;
+        if (!scanned && !sides && !closed) return;
+        const Relation rel = scene_.relation(from, to);
+        const std::vector<char>& near_vertex = plan.near_vertex[from];
+        const std::vector<Vec2>& points = scene_.layer(from).points;
+        SegmentIndex::Cursor cursor;
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            if (!near_vertex[k]) continue;
+            if (closed) {
+                const Placement where = placement(indices_[to], bounds_[to], points[k]);
+                if (rel == Relation::Under ? where == Placement::Outside
+                                           : where == Placement::Inside)
+                    ++nesting;
+            }
+            if (!scanned && !sides) continue;
+            // As scan_pair(): only a vertex closer than the gap so far (the layers meet: 0),
+            // or than required, changes the separation.
+            const double so_far = met[pair] ? 0.0 : std::min(gap, away_gap[pair]);
+            const double bound =
+                sides || !scanned ? cutoff : std::max(threshold, std::min(cutoff, so_far));
+            const Nearest nr = nearest_on(indices_[to], points[k], bound, &cursor);
+            if (!nr.found()) continue;
+            if (sides && nr.distance < near &&
+                breaks_nesting(from, k, to, side_of(indices_[to], points[k], nr)))
+                ++nesting;
+            if (!scanned) continue;
+            gap = std::min(gap, nr.distance);
+            if (nr.distance < threshold) ++separations;
+        }
+    }
+
+  public:
   private:
     void note_meeting(std::size_t a, std::size_t b, const Vec2& p) {
         if (!met_[a * n_ + b]) {
             met_[a * n_ + b] = 1;
             met_point_[a * n_ + b] = p;
         }
+    }
+
+    // A contact of the reference away from the plan's region.
+    void tally_away(const Contact& c) {
+        if (c.la == c.lb) {
+            ++away_->self_crossings;
+            return;
+        }
+        ++away_->crossings;
+        if (c.is_touch) ++away_->touches;
+        away_->met[c.la * n_ + c.lb] = 1;
     }
 
     void find_contacts() {
@@ -584,6 +678,8 @@ class Checker {
                     continue;
                 }
                 const Contact c{i, s, j, t, crossing_point(p0, p1, q0, q1), false};
+                if (away_ && !(plan_->near_segment[i][s] && plan_->near_segment[j][t]))
+                    tally_away(c);
                 if (i == j) {
                     ++report_.self_crossing_count[i];
                     if (proper_self.size() < cap) proper_self.push_back(c);
@@ -608,6 +704,7 @@ class Checker {
                       touches.end());
         std::vector<Contact> cross_touches, self_touches;
         for (const Contact& c : touches) {
+            if (away_ && !plan_->box.contains(c.point)) tally_away(c);
             if (c.la == c.lb) {
                 ++report_.self_crossing_count[c.la];
                 self_touches.push_back(c);
@@ -631,6 +728,10 @@ class Checker {
         bool listed = false;  // a near pair: goes into the report
         PairSeparation pair;
         std::vector<SeparationViolation> violations;
+        // With a region plan: the gap over the vertices away from the region (not 0 when the
+        // layers meet), and the violations there.
+        double away_gap = kInf;
+        std::size_t away_violations = 0;
     };
 
     // Pairs are scanned in parallel (TBB; one thread under a max_allowed_parallelism of 1),
@@ -656,6 +757,10 @@ class Checker {
                                   scan_pair(scans[k]);
                           });
         for (const PairScan& scan : scans) {
+            if (away_) {
+                away_->gap[scan.i * n_ + scan.j] = scan.away_gap;
+                away_->separation_violations += scan.away_violations;
+            }
             if (!scan.listed) continue;
             add_pair(scan.i, scan.j, scan.pair.gap, scan.required, scan.pair.at_a, scan.pair.at_b);
             report_.separation_violation_count += scan.violations.size();
@@ -674,38 +779,60 @@ class Checker {
         const bool met = met_[i * n_ + j] != 0;
         pair.gap = met ? 0.0 : kInf;
         pair.at_a = pair.at_b = met_point_[i * n_ + j];
-        if (met && threshold <= 0.0) {
+        // With a region plan the vertices away from it keep their own gap (away_gap, from
+        // +inf even when the layers meet: they may not meet in a scene moved in the region).
+        if (met && threshold <= 0.0 && !plan_) {
             scan.listed = true;
             return;
         }
+        // Away vertices: the closest so far, and where (its order in the scan).
+        PairSeparation away;
+        away.gap = kInf;
+        std::size_t away_order = kNone, order = 0, near_order = kNone;
         auto one_way = [&](std::size_t from, std::size_t to, bool from_is_a) {
             // Where nesting is decided by the side at the closest point, the same queries
             // (then with the whole cutoff >= near) decide it too.
             const bool sides = sides_by_nearest(from, to);
             if (sides) sides_scanned_[from * n_ + to] = 1;
             const std::vector<Vec2>& points = scene_.layer(from).points;
+            const std::vector<char>* near_vertex = plan_ ? &plan_->near_vertex[from] : nullptr;
             SegmentIndex::Cursor cursor;  // the previous vertex's query
-            for (std::size_t k = 0; k < points.size(); ++k) {
+            for (std::size_t k = 0; k < points.size(); ++k, ++order) {
+                const bool is_away = near_vertex && !(*near_vertex)[k];
+                PairSeparation& gap = is_away ? away : pair;
                 // Only a vertex closer than the pair's gap so far, or than required, changes
                 // the separation: the search stops there.
                 const double bound =
-                    sides ? cutoff : std::max(threshold, std::min(cutoff, pair.gap));
+                    sides ? cutoff : std::max(threshold, std::min(cutoff, gap.gap));
                 const Nearest nr = nearest_on(indices_[to], points[k], bound, &cursor);
                 if (!nr.found()) continue;
                 if (sides && nr.distance < near &&
                     breaks_nesting(from, k, to, side_of(indices_[to], points[k], nr)))
                     wrong_side_[from * n_ + to].push_back(k);
-                if (nr.distance < pair.gap) {
-                    pair.gap = nr.distance;
-                    pair.at_a = from_is_a ? points[k] : nr.point;
-                    pair.at_b = from_is_a ? nr.point : points[k];
+                if (nr.distance < gap.gap) {
+                    gap.gap = nr.distance;
+                    gap.at_a = from_is_a ? points[k] : nr.point;
+                    gap.at_b = from_is_a ? nr.point : points[k];
+                    (is_away ? away_order : near_order) = order;
                 }
-                if (nr.distance < threshold)
+                if (nr.distance < threshold) {
                     scan.violations.push_back({from, k, to, nr.distance, scan.required});
+                    if (is_away) ++scan.away_violations;
+                }
             }
         };
         one_way(i, j, true);
         one_way(j, i, false);
+        if (plan_) {
+            scan.away_gap = away.gap;
+            // The closest of both, the first in the scan on a tie: what one gap would keep.
+            if (!met &&
+                (away.gap < pair.gap || (away.gap == pair.gap && away_order < near_order))) {
+                pair.gap = away.gap;
+                pair.at_a = away.at_a;
+                pair.at_b = away.at_b;
+            }
+        }
         scan.listed = pair.gap < near;
     }
 
@@ -771,6 +898,7 @@ class Checker {
             for (std::size_t b = 0; b < n_; ++b) {
                 if (a == b) continue;
                 for (std::size_t k : wrong_side_[a * n_ + b]) {
+                    if (away_ && !plan_->near_vertex[a][k]) ++away_->nesting_violations;
                     ++report_.nesting_violation_count;
                     if (report_.nesting_violations.size() < params_.max_listed)
                         report_.nesting_violations.push_back({a, k, b, scene_.relation(a, b)});
@@ -801,6 +929,8 @@ class Checker {
 
     const Scene& scene_;
     const CheckParams& params_;
+    const RegionPlan* plan_ = nullptr;  // run(plan, away): what is near the region
+    Away* away_ = nullptr;              // and what run() found away from it
     std::size_t n_ = 0;
     std::vector<SegmentIndex> indices_;
     std::vector<Box2> bounds_;
@@ -814,6 +944,134 @@ class Checker {
     mutable std::vector<std::vector<std::size_t>> wrong_side_;
     CheckReport report_;
 };
+
+CheckCounts Checker::run_region(const RegionPlan& plan, const Away& away) {
+    plan_ = &plan;
+    find_outside_sides();
+    const Box2& region = plan.box;
+    CheckCounts counts;
+    counts.crossing_count = away.crossings;
+    counts.touch_count = away.touches;
+    counts.self_crossing_count = away.self_crossings;
+    counts.separation_violation_count = away.separation_violations;
+    counts.nesting_violation_count = away.nesting_violations;
+    std::vector<char> met = away.met;
+    // Contacts between the segments near the region, as find_contacts() finds them; of the
+    // touches, those at a point in the region (the others do not change).
+    std::vector<std::pair<std::size_t, std::size_t>> owner;
+    std::vector<Box2> boxes;
+    std::vector<double> lengths;
+    Box2 all;
+    for (std::size_t i = 0; i < n_; ++i)
+        for (std::size_t s : indices_[i].segments()) {
+            if (!plan.near_segment[i][s]) continue;
+            owner.emplace_back(i, s);
+            boxes.push_back(indices_[i].box(s));
+            all.extend(boxes.back());
+            const Vec2 d = indices_[i].end(s) - indices_[i].start(s);
+            lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));
+        }
+    std::vector<Contact> touches;
+    if (!owner.empty()) {
+        std::vector<std::uint32_t> ids(owner.size());
+        for (std::size_t id = 0; id < ids.size(); ++id) ids[id] = static_cast<std::uint32_t>(id);
+        detail::UniformGrid<std::uint32_t> grid =
+            segment_grid(all, median_of(lengths), owner.size());
+        grid.build(ids, [&](std::uint32_t id) { return boxes[id]; });
+        std::vector<std::uint32_t> hits;
+        for (std::size_t id = 0; id < owner.size(); ++id) {
+            const auto [i, s] = owner[id];
+            const SegmentIndex& a = indices_[i];
+            const Vec2 p0 = a.start(s), p1 = a.end(s);
+            hits.clear();
+            const Box2& own = boxes[id];
+            grid.query(own, [&](std::uint32_t hit) {
+                if (hit > id && boxes[hit].overlaps(own)) hits.push_back(hit);
+            });
+            std::sort(hits.begin(), hits.end());
+            hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+            for (const std::uint32_t hit : hits) {
+                const auto [j, t] = owner[hit];
+                const SegmentIndex& b = indices_[j];
+                const Vec2 q0 = b.start(t), q1 = b.end(t);
+                if (i == j && (a.next(s) == t || a.next(t) == s)) {
+                    Vec2 point;
+                    if (((a.next(s) == t && folds_back(p0, p1, q1, point)) ||
+                         (a.next(t) == s && folds_back(q0, q1, p1, point))) &&
+                        region.contains(point))
+                        touches.push_back({i, s, j, t, point, true});
+                    continue;
+                }
+                const SegmentContact contact = segment_contact(p0, p1, q0, q1);
+                if (contact == SegmentContact::None) continue;
+                if (contact == SegmentContact::Touch) {
+                    const Vec2 point = touch_point(p0, p1, q0, q1);
+                    if (region.contains(point)) touches.push_back({i, s, j, t, point, true});
+                    continue;
+                }
+                if (i == j) {
+                    ++counts.self_crossing_count;
+                } else {
+                    ++counts.crossing_count;
+                    met[i * n_ + j] = 1;
+                }
+            }
+        }
+    }
+    std::sort(touches.begin(), touches.end(), [](const Contact& x, const Contact& y) {
+        return std::tie(x.la, x.lb, x.point.x, x.point.y) <
+               std::tie(y.la, y.lb, y.point.x, y.point.y);
+    });
+    touches.erase(std::unique(touches.begin(), touches.end(),
+                              [](const Contact& x, const Contact& y) {
+                                  return x.la == y.la && x.lb == y.lb && x.point == y.point;
+                              }),
+                  touches.end());
+    for (const Contact& c : touches) {
+        if (c.la == c.lb) {
+            ++counts.self_crossing_count;
+        } else {
+            ++counts.crossing_count;
+            ++counts.touch_count;
+            met[c.la * n_ + c.lb] = 1;
+        }
+    }
+    // Separations and nesting of the vertices near the region, as find_separations() and
+    // find_nesting_violations() judge them; ordered pairs of layers in parallel, each with
+    // its own counts and gap, summed in order (the counts do not depend on the threads).
+    const double near = report_.near_distance;
+    struct Task {
+        std::size_t from = 0, to = 0;
+        std::size_t separations = 0, nesting = 0;
+        double gap = kInf;
+    };
+    std::vector<Task> tasks;
+    for (std::size_t from = 0; from < n_; ++from)
+        for (std::size_t to = 0; to < n_; ++to)
+            if (to != from) tasks.push_back({from, to});
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t t = range.begin(); t != range.end(); ++t)
+                              scan_near_region(plan, met, away.gap, tasks[t].from, tasks[t].to,
+                                               tasks[t].gap, tasks[t].separations,
+                                               tasks[t].nesting);
+                      });
+    std::vector<double> gap = away.gap;
+    for (const Task& task : tasks) {
+        const std::size_t pair = std::min(task.from, task.to) * n_ + std::max(task.from, task.to);
+        gap[pair] = std::min(gap[pair], task.gap);
+        counts.separation_violation_count += task.separations;
+        counts.nesting_violation_count += task.nesting;
+    }
+    for (std::size_t i = 0; i < n_; ++i)
+        for (std::size_t j = i + 1; j < n_; ++j) {
+            const double required = scene_.required_separation(i, j);
+            const double g = met[i * n_ + j] ? 0.0 : gap[i * n_ + j];
+            if (g < near && required > 0.0)
+                counts.min_separation_ratio = std::min(counts.min_separation_ratio, g / required);
+        }
+    return counts;
+}
 
 // max over the points of `a` of the distance to `b`, by branch and bound (see hausdorff()).
 // An interval [p0, p1] of a segment of `a`, with nearest segments s0, s1 of `b` at its ends,
@@ -923,7 +1181,10 @@ double automatic_near_distance(const Scene& scene) {
     return automatic_near(scene);
 }
 
-CheckReport check_scene(const Scene& scene, const CheckParams& params) {
+namespace {
+
+// validate(params), and params.outside_sides against `scene`.
+void validate_outside_sides(const Scene& scene, const CheckParams& params) {
     validate(params);
     if (!params.outside_sides.empty() && params.outside_sides.size() != scene.size())
         throw InvalidInput("check: params.outside_sides has " +
@@ -934,6 +1195,12 @@ CheckReport check_scene(const Scene& scene, const CheckParams& params) {
             throw InvalidInput("check: params.outside_sides[" + std::to_string(i) + "] (layer '" +
                                scene.layer(i).name + "') must be +1 or -1 (got " +
                                std::to_string(params.outside_sides[i]) + ")");
+}
+
+}  // namespace
+
+CheckReport check_scene(const Scene& scene, const CheckParams& params) {
+    validate_outside_sides(scene, params);
     return Checker(scene, params).run();
 }
 
@@ -1124,6 +1391,126 @@ HausdorffDistance hausdorff(const Layer& a, const Layer& b, double tolerance) {
     result.a_to_b = one_sided_hausdorff(sa, ib, tolerance);
     result.b_to_a = one_sided_hausdorff(sb, ia, tolerance);
     return result;
+}
+
+CheckCounts counts_of(const CheckReport& report) {
+    CheckCounts counts;
+    counts.crossing_count = report.crossing_count;
+    counts.touch_count = report.touch_count;
+    counts.self_crossing_count = report.total_self_crossings();
+    counts.separation_violation_count = report.separation_violation_count;
+    counts.nesting_violation_count = report.nesting_violation_count;
+    counts.min_separation_ratio = report.min_separation_ratio;
+    return counts;
+}
+
+struct RegionCheck::State {
+    const Scene* reference = nullptr;
+    CheckParams params;
+    bool is_enabled = false;  // else every check() checks the whole scene
+    RegionPlan plan;
+    Away away;
+    CheckReport report;
+    CheckCounts counts;  // of `report`
+    std::size_t whole_checks = 0;
+};
+
+RegionCheck::RegionCheck(const Scene& reference, const CheckParams& params, const Box2& region)
+    : state_(std::make_unique<State>()) {
+    State& st = *state_;
+    st.reference = &reference;
+    st.params = params;
+    st.is_enabled = !region.is_empty() && !params.outside_sides.empty();
+    if (!st.is_enabled) {
+        st.report = check_scene(reference, params);
+        st.counts = counts_of(st.report);
+        return;
+    }
+    validate_outside_sides(reference, params);
+    RegionPlan& plan = st.plan;
+    plan.box = region;
+    const double near =
+        params.near_distance > 0.0 ? params.near_distance : automatic_near(reference);
+    double largest = 0.0;
+    for (std::size_t a = 0; a < reference.size(); ++a)
+        for (std::size_t b = a + 1; b < reference.size(); ++b)
+            largest = std::max(largest, reference.required_separation(a, b));
+    plan.reach = std::max(near, largest * (1.0 - params.separation_tolerance));
+    for (const Layer& layer : reference.layers()) {
+        plan.near_vertex.emplace_back(layer.points.size(), 0);
+        plan.near_segment.emplace_back(layer.segment_count(), 0);
+        for (std::size_t k = 0; k < layer.points.size(); ++k) {
+            const Vec2& p = layer.points[k];
+            const double dx = std::max({region.min.x - p.x, p.x - region.max.x, 0.0});
+            const double dy = std::max({region.min.y - p.y, p.y - region.max.y, 0.0});
+            plan.near_vertex.back()[k] = dx * dx + dy * dy <= plan.reach * plan.reach;
+        }
+        for (std::size_t s = 0; s < layer.segment_count(); ++s) {
+            Box2 b;
+            b.extend(layer.segment_start(s));
+            b.extend(layer.segment_end(s));
+            plan.near_segment.back()[s] = b.overlaps(region);
+        }
+    }
+    st.report = Checker(reference, st.params).run(plan, st.away);
+    st.counts = counts_of(st.report);
+}
+
+RegionCheck::~RegionCheck() = default;
+RegionCheck::RegionCheck(RegionCheck&&) noexcept = default;
+RegionCheck& RegionCheck::operator=(RegionCheck&&) noexcept = default;
+
+const CheckReport& RegionCheck::reference_report() const {
+    return state_->report;
+}
+
+std::size_t RegionCheck::whole_checks() const {
+    return state_->whole_checks;
+}
+
+CheckCounts RegionCheck::check(const Scene& scene) const {
+    State& st = *state_;
+    const Scene& reference = *st.reference;
+    if (scene.size() != reference.size())
+        throw InvalidInput("RegionCheck::check: the scene has " + std::to_string(scene.size()) +
+                           " layers, the reference " + std::to_string(reference.size()));
+    for (std::size_t l = 0; l < scene.size(); ++l)
+        if (scene.layer(l).points.size() != reference.layer(l).points.size() ||
+            scene.layer(l).closed != reference.layer(l).closed)
+            throw InvalidInput("RegionCheck::check: layer " + std::to_string(l) +
+                               " differs from the reference's in vertex count or closedness");
+    auto whole = [&] {
+        ++st.whole_checks;
+        return counts_of(check_scene(scene, st.params));
+    };
+    if (!st.is_enabled) return whole();
+    // Every moved vertex, its neighbours and the segments between them (before and after)
+    // inside the region, none of those segments of zero length (which would change which
+    // segments are adjacent): else the whole scene is checked.
+    const Box2& region = st.plan.box;
+    bool moved_any = false;
+    for (std::size_t l = 0; l < scene.size(); ++l) {
+        const std::vector<Vec2>& now = scene.layer(l).points;
+        const std::vector<Vec2>& then = reference.layer(l).points;
+        const std::size_t n = now.size();
+        const bool closed = scene.layer(l).closed;
+        for (std::size_t v = 0; v < n; ++v) {
+            if (now[v] == then[v]) continue;
+            moved_any = true;
+            if (n < 3) return whole();
+            if (!region.contains(now[v]) || !region.contains(then[v])) return whole();
+            const bool has_previous = closed || v > 0, has_next = closed || v + 1 < n;
+            for (const std::size_t w : {(v + n - 1) % n, (v + 1) % n}) {
+                if (w == (v + n - 1) % n ? !has_previous : !has_next) continue;
+                if (!region.contains(now[w]) || !region.contains(then[w])) return whole();
+                if (now[w] == now[v] || then[w] == then[v]) return whole();
+            }
+        }
+    }
+    if (!moved_any) return st.counts;
+    if (st.params.near_distance == 0.0 && automatic_near(scene) != st.report.near_distance)
+        return whole();
+    return Checker(scene, st.params).run_region(st.plan, st.away);
 }
 
 }  // namespace strata

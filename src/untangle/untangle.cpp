@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -47,8 +48,12 @@ std::size_t rolled_kept(const Scene& scene, const InputSides& sides,
     return rolled - std::min(rolled, lost);
 }
 
+// `region`: the vertices that may move (the free vertices of `pieces`) stay in this box, with
+// their neighbours, or the check is of the whole scene; the checks then look only near it
+// (RegionCheck), with the same verdicts as whole ones. nullptr: whole checks.
 UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const UntangleParams& params,
-                   const ProgressFn& progress, bool keep_simple = false) {
+                   const ProgressFn& progress, bool keep_simple = false,
+                   const Box2* region = nullptr) {
     validate(params);
     validate_sides(scene, params);
     UntangleReport report;
@@ -70,11 +75,23 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         settings.keep_simple = keep_simple;
         const bool has_sides = params.input_sides && !params.input_sides->empty();
         check_params.input_sides = has_sides ? params.input_sides : nullptr;
-        CheckReport check = check_scene(scene, check_params);
-        report.crossings_before = check.crossing_count;
+        // `check`: the last whole check, if any; `counts`: the last check's counts.
+        std::optional<RegionCheck> region_check;
+        CheckReport check;
+        if (region)
+            check = region_check.emplace(original, check_params, *region).reference_report();
+        else
+            check = check_scene(scene, check_params);
+        CheckCounts counts = counts_of(check);
+        report.crossings_before = counts.crossing_count;
         auto is_ok = [&](const Scene& s) {
-            check = check_scene(s, check_params);
-            return check.is_collision_free() && check.separations_hold();
+            if (region_check) {
+                counts = region_check->check(s);
+            } else {
+                check = check_scene(s, check_params);
+                counts = counts_of(check);
+            }
+            return counts.is_collision_free() && counts.separations_hold();
         };
         detail::RelationSource relations;
         relations.scene = &original;
@@ -98,12 +115,14 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         report.seconds_finish = r.seconds_finish;
         report.finishes = r.finishes;
         report.finish_moves = r.finish_moves;
-        report.crossings_after = check.crossing_count;
-        report.min_separation_ratio_after = check.min_separation_ratio;
+        report.crossings_after = counts.crossing_count;
+        report.min_separation_ratio_after = counts.min_separation_ratio;
         if (report.rolled_vertices > 0) {
-            // The last check judged the final scene; list every violation if it did not.
-            if (check.nesting_violations.size() < check.nesting_violation_count) {
-                check_params.max_listed = check.nesting_violation_count;
+            // The last check judged the final scene; list every violation if it did not (a
+            // region check lists none).
+            if (region_check || check.nesting_violations.size() < check.nesting_violation_count) {
+                check_params.max_listed =
+                    std::max(check_params.max_listed, counts.nesting_violation_count);
                 check = check_scene(scene, check_params);
             }
             report.rolled_kept = rolled_kept(original, *params.input_sides, settings.outside_signs,
@@ -393,7 +412,15 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
 
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,
                               const UntangleParams& params, const ProgressFn& progress) {
-    return run(scene, localize(scene, box, n_out), params, progress);
+    const std::vector<Piece> pieces = localize(scene, box, n_out);
+    // The checks look near the pieces (free vertices and collars), with room for the free
+    // vertices to move by half the pieces' extent; a move beyond is checked whole.
+    Box2 region;
+    for (const Piece& piece : pieces)
+        for (std::size_t v : piece.vertices) region.extend(scene.layer(piece.layer).points[v]);
+    const Vec2 size = region.size();
+    region = region.inflated(0.5 * std::max(size.x, size.y));
+    return run(scene, pieces, params, progress, false, &region);
 }
 
 }  // namespace strata
