@@ -5,6 +5,8 @@
 #include "strata/geometry/checks.h"
 #include "untangle/detail/engine.h"
 
+#include <tbb/task_group.h>
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -75,16 +77,42 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         settings.keep_simple = keep_simple;
         const bool has_sides = params.input_sides && !params.input_sides->empty();
         check_params.input_sides = has_sides ? params.input_sides : nullptr;
-        // `check`: the last whole check, if any; `counts`: the last check's counts.
+        // `check`: the last whole check, if any; `counts`: the last check's counts. The check
+        // of the input (the reference of the region checks) runs beside the engine's first
+        // steps (the fields, the finishing stage, which do not use it); the first verdict
+        // waits for it.
         std::optional<RegionCheck> region_check;
         CheckReport check;
-        if (region)
-            check = region_check.emplace(original, check_params, *region).reference_report();
-        else
-            check = check_scene(scene, check_params);
-        CheckCounts counts = counts_of(check);
-        report.crossings_before = counts.crossing_count;
+        CheckCounts counts;
+        tbb::task_group checking;
+        bool is_checking = true;
+        checking.run([&] {
+            if (region)
+                check = region_check.emplace(original, check_params, *region).reference_report();
+            else
+                check = check_scene(original, check_params);
+        });
+        auto checked = [&] {
+            if (!is_checking) return;
+            is_checking = false;
+            checking.wait();
+            counts = counts_of(check);
+            report.crossings_before = counts.crossing_count;
+        };
+        // Waits for the check of the input before leaving (it reads `original`).
+        struct Waiter {
+            tbb::task_group& group;
+            bool& is_running;
+            ~Waiter() {
+                if (!is_running) return;
+                try {
+                    group.wait();
+                } catch (...) {  // leaving on another exception already
+                }
+            }
+        } waiter{checking, is_checking};
         auto is_ok = [&](const Scene& s) {
+            checked();
             if (region_check) {
                 counts = region_check->check(s);
             } else {
@@ -103,6 +131,7 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         }
         const detail::EngineResult r =
             detail::run_engine(scene, pieces, params, relations, settings, is_ok, progress);
+        checked();
         report.passes = r.passes;
         report.rounds = r.rounds;
         report.converged = r.converged;
