@@ -1412,7 +1412,7 @@ struct RegionCheck::State {
     Away away;
     CheckReport report;
     CheckCounts counts;  // of `report`
-    std::size_t whole_checks = 0;
+    std::atomic<std::size_t> whole_checks{0};  // check() may be called from several threads
 };
 
 RegionCheck::RegionCheck(const Scene& reference, const CheckParams& params, const Box2& region)

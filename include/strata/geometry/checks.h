@@ -181,7 +181,7 @@ class RegionCheck {
     RegionCheck(RegionCheck&&) noexcept;
     RegionCheck& operator=(RegionCheck&&) noexcept;
 
-    /// check_scene(reference, params), whole.
+    /// check_scene(reference, params), whole. check() may be called from several threads.
     const CheckReport& reference_report() const;
     /// The counts of check_scene(scene, params). `scene`: the reference with some vertices
     /// moved (same layers, vertex counts, closedness, relations and thicknesses).
