@@ -142,6 +142,45 @@ TEST_CASE("local untangling moves nothing outside the box", "[untangle][localize
                 CHECK(scene.layer(l).points[v] == before.layer(l).points[v]);
 }
 
+TEST_CASE("local untangling reports what a whole-scene check of its result says",
+          "[untangle][localize]") {
+    // Its checks look near the box only (RegionCheck): its report must still be the whole
+    // scene's. Closed loops, and open layers with a dent pushed through the next one.
+    std::vector<Scene> scenes;
+    scenes.push_back(
+        Scene({circle("inner", {0.3, 0.0}, 1.0, 64), circle("outer", {0, 0}, 1.2, 64)}));
+    std::vector<Layer> open;
+    for (int l = 0; l < 3; ++l) {
+        Layer layer;
+        layer.name = "open" + std::to_string(l);
+        layer.thickness = 0.02;
+        for (int i = 0; i <= 200; ++i) {
+            const double x = 0.05 * i;
+            const double dent = l == 1 && i > 95 && i < 105 ? 0.25 : 0.0;
+            layer.points.emplace_back(x, 0.1 * std::sin(x) + 0.15 * l - dent);
+        }
+        open.push_back(std::move(layer));
+    }
+    scenes.emplace_back(std::move(open));
+    const std::vector<Box2> boxes = {Box2{{0.8, -0.9}, {1.5, 0.9}}, Box2{{4.6, -0.5}, {5.4, 0.6}}};
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+        Scene scene = scenes[k];
+        const UntangleParams params = exact_params();
+        CheckParams check;
+        check.separation_tolerance = params.separation_tolerance;
+        check.outside_sides = outside_sides(scenes[k]);
+        const std::size_t before = check_scene(scenes[k], check).crossing_count;
+        CHECK(before > 0);
+        const UntangleReport report = untangle_local(scene, boxes[k], 7, params);
+        const CheckReport after = check_scene(scene, check);
+        CHECK(report.crossings_before == before);
+        CHECK(report.crossings_after == after.crossing_count);
+        CHECK(report.min_separation_ratio_after == after.min_separation_ratio);
+        CHECK(report.collision_free == (after.is_collision_free() && after.separations_hold()));
+        CHECK(report.collision_free);
+    }
+}
+
 TEST_CASE("an untangling that cannot finish in its passes gives up early when asked",
           "[untangle]") {
     // Two straight layers 0.05 apart that must keep 0.2, with steps clamped to 0.05% of an
