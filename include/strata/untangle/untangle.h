@@ -186,7 +186,9 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
 
 /// @brief Untangles only the vertices of `scene` inside `box`, with collars of `n_out` fixed
 /// vertices (localize()). The fields are built for whole layers here; the simplification
-/// driver keeps them and updates them only inside its boxes.
+/// driver keeps them and updates them only inside its boxes. The input is checked whole once;
+/// the later checks look only near the pieces (RegionCheck over their box grown by half its
+/// larger side), with the verdicts and counts of whole checks.
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out = 7,
                               const UntangleParams& params = {}, const ProgressFn& progress = {});
 
