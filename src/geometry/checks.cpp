@@ -1,5 +1,6 @@
 #include "strata/geometry/checks.h"
 
+#include "geometry/detail/region_check.h"
 #include "geometry/detail/uniform_grid.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"

@@ -1,5 +1,6 @@
 #include "strata/untangle/untangle.h"
 
+#include "geometry/detail/region_check.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"

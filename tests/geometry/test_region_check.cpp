@@ -1,5 +1,6 @@
 // RegionCheck: the counts of check_scene() from a check near the moved region only, compared
 // with check_scene() itself on random scenes and random moves.
+#include "geometry/detail/region_check.h"
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
 #include "strata/geometry/input_sides.h"
