@@ -66,6 +66,11 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
             "last resort: the exact check of the result failed where the local checks could "
             "not see; %zu input vertices came back around it\n",
             r.restored);
+    if (r.trimmed_ends > 0)
+        std::printf(
+            "budget: %zu end vertices of open layers taken out to meet their target "
+            "(--no-trim-ends keeps them)\n",
+            r.trimmed_ends);
     if (r.rolled_vertices > 0)
         std::printf(
             "local sides: %zu output vertices lie on the other side of an open layer than the "
@@ -190,6 +195,9 @@ Run add_simplify_command(CLI::App& app) {
     cmd->add_flag("--global", p.global,
                   "Untangle the whole scene after each tangling removal (slow; comparison)");
     cmd->add_flag("--no-untangle", opt->naive, "Naive decimation only");
+    cmd->add_flag_callback(
+        "--no-trim-ends", [opt] { opt->params.trim_ends = false; },
+        "Open layers keep both ends even when that leaves them above their target");
     cmd->add_flag("--compare-naive", opt->compare_naive,
                   "Also run the naive decimation, for its numbers (the demo always does)");
     static const std::map<std::string, InputCrossings> crossing_modes{

@@ -70,6 +70,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"raised_separations", r.raised_separations},
                         {"rolled_vertices", r.rolled_vertices},
                         {"restored", r.restored},
+                        {"trimmed_ends", r.trimmed_ends},
                         {"crossings", r.crossings},
                         {"self_crossings", r.self_crossings},
                         {"nesting_violations", r.nesting_violations},

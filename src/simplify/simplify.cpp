@@ -150,6 +150,23 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
                 input_sides.renumbered(report.origins).rolled_count(out, outside_signs);
         }
     }
+    bool above_target = false;
+    for (std::size_t l = 0; l < out.size(); ++l)
+        above_target = above_target || out.layer(l).points.size() > live.layer(l).target;
+    if (params.untangle && above_target && detail::passes(check_report)) {
+        // Layers left above their target: removals the exact check of the whole scene allows
+        // where the local ones refused, then end vertices of open layers (trim_ends).
+        detail::Restored thinned{out, report.origins, check_report, 0, 0};
+        std::vector<std::size_t> targets(input.size());
+        for (std::size_t l = 0; l < input.size(); ++l) targets[l] = live.layer(l).target;
+        report.trimmed_ends = detail::meet_targets(input, thinned, targets, check_params,
+                                                   input_sides, params.trim_ends);
+        out = std::move(thinned.scene);
+        report.origins = std::move(thinned.origins);
+        check_report = std::move(thinned.check);
+        report.rolled_vertices =
+            input_sides.renumbered(report.origins).rolled_count(out, outside_signs);
+    }
     report.crossings = check_report.crossing_count;
     report.self_crossings = check_report.total_self_crossings();
     report.nesting_violations = check_report.nesting_violation_count;

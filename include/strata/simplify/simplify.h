@@ -45,6 +45,15 @@ struct SimplifyParams {
     /// which pass a gap at required x (1 - separation_tolerance), keep this share. [0, 1];
     /// 0 = off (such pairs may then come as close as the untangler's min_separation).
     double keep_input_gaps = 0.9;
+    /// When the run leaves a layer above its target (every removal left refused by the local
+    /// checks and their untanglings), an open layer may lose end vertices: the end of its
+    /// shorter end segment first, kept only where the exact check of the whole scene passes
+    /// (docs/simplify.md, *Meeting the budget*). The trimmed piece is part of the one before:
+    /// it crosses nothing new and keeps every gap, but it is shorter (an open piece wrapped
+    /// around another layer, whose wrap needs more vertices than its target, loses its ends
+    /// instead). false: open layers keep both ends, whatever their target. No effect on a run
+    /// that meets every target.
+    bool trim_ends = true;
     std::uint64_t seed = 1;  ///< Seed of the random decimator.
     bool untangle = true;    ///< false: naive decimation (the paper's left-hand images).
     bool global = false;     ///< Untangle the whole scene instead of a box (for comparison).
@@ -128,6 +137,8 @@ struct SimplifyReport {
     /// always; 0 when untangle is false (naive decimation keeps its collisions) and when even
     /// the whole input fails the check (a tangled input: the result is returned as it is).
     std::size_t restored = 0;
+    /// End vertices of open layers taken out to meet their target (SimplifyParams::trim_ends).
+    std::size_t trimmed_ends = 0;
     /// Per layer, the input index of every output vertex, in output order (a simplification
     /// keeps vertices and their order; InputSides::renumbered() takes it).
     std::vector<std::vector<std::size_t>> origins;

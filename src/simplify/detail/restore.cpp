@@ -3,6 +3,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <tuple>
 #include <utility>
@@ -148,7 +149,98 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
     }
 }
 
+// The scene of `input`'s kind with, per layer, the vertices of `base` whose `kept` flag is set;
+// checked (`params`, the sides renumbered): true and `result` replaced if it passes.
+bool take_if_passes(const Scene& input, const Scene& base,
+                    const std::vector<std::vector<std::size_t>>& base_origins,
+                    const std::vector<std::vector<char>>& kept, CheckParams params,
+                    const InputSides& sides, Restored& result) {
+    const std::size_t layers = base.size();
+    std::vector<Layer> thinned = base.layers();
+    std::vector<std::vector<std::size_t>> origins(layers);
+    for (std::size_t l = 0; l < layers; ++l) {
+        thinned[l].points.clear();
+        for (std::size_t k = 0; k < kept[l].size(); ++k)
+            if (kept[l][k]) {
+                thinned[l].points.push_back(base.layer(l).points[k]);
+                origins[l].push_back(base_origins[l][k]);
+            }
+    }
+    Scene scene = like_input(input, std::move(thinned));
+    // The Scene drops a point equal to its neighbour: then the origins no longer match.
+    for (std::size_t l = 0; l < layers; ++l)
+        if (scene.layer(l).points.size() != origins[l].size()) return false;
+    const InputSides renumbered = sides.renumbered(origins);
+    params.input_sides = &renumbered;
+    CheckReport check = check_scene(scene, params);
+    if (!passes(check)) return false;
+    result.scene = std::move(scene);
+    result.origins = std::move(origins);
+    result.check = std::move(check);
+    return true;
+}
+
+bool above_targets(const Scene& scene, const std::vector<std::size_t>& targets) {
+    for (std::size_t l = 0; l < scene.size(); ++l)
+        if (scene.layer(l).points.size() > targets[l]) return true;
+    return false;
+}
+
 }  // namespace
+
+std::size_t meet_targets(const Scene& input, Restored& result,
+                         const std::vector<std::size_t>& targets, CheckParams params,
+                         const InputSides& sides, bool trim_ends) {
+    const std::size_t max_checks =
+        std::max<std::size_t>(1, kThinningBudget / std::max<std::size_t>(1, input.vertex_count()));
+    auto thin_all = [&] {
+        std::vector<std::vector<char>> came_back(result.scene.size());
+        for (std::size_t l = 0; l < result.scene.size(); ++l)
+            came_back[l].assign(result.scene.layer(l).points.size(), 0);
+        thin(input, result, came_back, targets, params, sides, max_checks);
+    };
+    thin_all();
+    std::size_t trimmed = 0;
+    const Vec2 size = input.bounds().size();
+    const double tolerance = 1e-6 * std::max(std::hypot(size.x, size.y), 1e-300);
+    if (!trim_ends) return trimmed;
+    for (std::size_t checks = 0; checks < max_checks && above_targets(result.scene, targets);) {
+        bool took = false;
+        for (std::size_t l = 0; l < result.scene.size() && checks < max_checks; ++l) {
+            const Layer& layer = result.scene.layer(l);
+            const std::size_t n = layer.points.size();
+            if (layer.closed || n <= std::max<std::size_t>(targets[l], 2)) continue;
+            // The end whose removal leaves the layer nearer its input first (Hausdorff), the
+            // end of the shorter segment where that ties.
+            auto cost = [&](std::size_t end) {
+                Layer rest = layer;
+                rest.points.erase(rest.points.begin() + static_cast<std::ptrdiff_t>(end));
+                return std::make_pair(
+                    hausdorff(rest, input.layer(l), tolerance).symmetric(),
+                    glm::distance(layer.points[end], layer.points[end == 0 ? 1 : n - 2]));
+            };
+            const bool first_first = cost(0) <= cost(n - 1);
+            const Scene base = result.scene;
+            const std::vector<std::vector<std::size_t>> base_origins = result.origins;
+            for (const std::size_t end : first_first ? std::array<std::size_t, 2>{0, n - 1}
+                                                     : std::array<std::size_t, 2>{n - 1, 0}) {
+                std::vector<std::vector<char>> kept(base.size());
+                for (std::size_t k = 0; k < base.size(); ++k)
+                    kept[k].assign(base.layer(k).points.size(), 1);
+                kept[l][end] = 0;
+                ++checks;
+                if (take_if_passes(input, base, base_origins, kept, params, sides, result)) {
+                    ++trimmed;
+                    took = true;
+                    break;
+                }
+            }
+        }
+        if (!took) break;
+        thin_all();
+    }
+    return trimmed;
+}
 
 Restored restore_near_violations(const Scene& input, const LivePolylines& live, const Scene& out,
                                  const CheckReport& check, CheckParams params,

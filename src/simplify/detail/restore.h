@@ -38,6 +38,20 @@ Restored restore_near_violations(const Scene& input, const LivePolylines& live, 
                                  const CheckReport& check, CheckParams params,
                                  const InputSides& sides);
 
+/// @brief The layers of `result` (a scene that passes the exact check, with its origins and
+/// check) above their target (`targets`) lose vertices while the exact check of the whole
+/// scene still passes: inner vertices first, cheapest first (as after a restore); then, if
+/// `trim_ends`, an open layer still above its target loses an end vertex, first the one whose
+/// removal leaves the layer nearer its input layer (symmetric Hausdorff distance; its
+/// neighbour becomes the end), and its inner vertices are tried again, until it is on its target or
+/// neither end can go. A trimmed polyline is part of the one before, so it crosses nothing new and
+/// keeps every gap: what the check can refuse is a side (a vertex of another layer whose closest
+/// point was on the segment taken out). `params`: the check's parameters, whose input_sides is
+/// replaced by `sides` renumbered to each candidate. Returns the end vertices taken out.
+std::size_t meet_targets(const Scene& input, Restored& result,
+                         const std::vector<std::size_t>& targets, CheckParams params,
+                         const InputSides& sides, bool trim_ends);
+
 /// Whether `report` passes: no crossing, nesting kept, separations within tolerance.
 inline bool passes(const CheckReport& report) {
     return report.is_collision_free() && report.separations_hold();
