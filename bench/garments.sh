@@ -82,9 +82,11 @@ over = sum(1 for r in ok for l in r["layers"] if l["after"] > 1.05 * l["target"]
 # the floor of 3 vertices of a closed layer).
 over_slices = sum(1 for r in ok if sum(l["after"] for l in r["layers"]) >
                   1.05 * sum(l["target"] for l in r["layers"]))
-print("%-20s %6d %9d %6d %9d %8d %9d %8d %8d %8d %8d %8d %9s %5d %6ss %d" % (sys.argv[2], len(runs), untangled,
-      len(runs) - len(ok), before, after, naive, strata, tangled, refused, over_slices, over, sys.argv[4], int(sys.argv[5]),
-      sys.argv[3], broken))
+# End vertices of open layers taken out to meet a target (SimplifyParams::trim_ends).
+trimmed = sum(r.get("trimmed_ends", 0) for r in ok)
+print("%-20s %6d %9d %6d %9d %8d %9d %8d %8d %8d %8d %8d %6d %9s %5d %6ss %d" % (sys.argv[2], len(runs), untangled,
+      len(runs) - len(ok), before, after, naive, strata, tangled, refused, over_slices, over, trimmed, sys.argv[4],
+      int(sys.argv[5]), sys.argv[3], broken))
 PY
 )")
 }
@@ -103,14 +105,15 @@ echo "(strata check: crossings or self-crossings > 0)"
 echo "nest-viol: crossing-free slices whose inferred nesting strata check rejects"
 echo "slices in $out"
 echo
-printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %8s %8s %9s %5s %7s %s\n' outfit slices untangled failed vertices \
-  after "naive-x" "strata-x" tangled refused "sl-5%" "over-5%" "gap-ratio" "<0.9" time bad
+printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %8s %8s %6s %9s %5s %7s %s\n' outfit slices untangled failed vertices \
+  after "naive-x" "strata-x" tangled refused "sl-5%" "over-5%" ends "gap-ratio" "<0.9" time bad
 for r in "${srows[@]}"; do echo "$r"; done
 echo "untangled: inputs that crossed, untangled before simplifying; failed: not simplified (the"
 echo "reason is in the .simplify.json: e.g. a layer that crosses itself cannot be untangled);"
 echo "naive-x / strata-x: crossings after naive decimation / after strata; tangled: outputs not collision-free;"
 echo "sl-5%: slices whose vertices exceed the sum of their layers' targets by more than 5%;"
 echo "over-5%: layers (of more than 3 vertices) kept more than 5% above their target;"
+echo "ends: end vertices of open layers taken out to meet a target (strata simplify --no-trim-ends keeps them);"
 echo "gap-ratio: smallest gap after / gap before over the near pairs that do not cross in the input (bench/gap_ratios.py); <0.9: pairs below 0.9;"
 echo "bad: of those, outputs of inputs that were collision-free as read (the guarantee)"
 echo "galleries: $out/<outfit>.html"
