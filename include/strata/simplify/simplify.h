@@ -46,8 +46,9 @@ struct SimplifyParams {
     /// 0 = off (such pairs may then come as close as the untangler's min_separation).
     double keep_input_gaps = 0.9;
     /// When the run leaves a layer above its target (every removal left refused by the local
-    /// checks and their untanglings), an open layer may lose end vertices: the end of its
-    /// shorter end segment first, kept only where the exact check of the whole scene passes
+    /// checks and their untanglings, then by the exact check of the whole scene), an open
+    /// layer may lose end vertices: first the end whose removal leaves it nearer its input
+    /// (Hausdorff), kept only where the exact check of the whole scene passes
     /// (docs/simplify.md, *Meeting the budget*). The trimmed piece is part of the one before:
     /// it crosses nothing new and keeps every gap, but it is shorter (an open piece wrapped
     /// around another layer, whose wrap needs more vertices than its target, loses its ends
@@ -138,6 +139,7 @@ struct SimplifyReport {
     /// the whole input fails the check (a tangled input: the result is returned as it is).
     std::size_t restored = 0;
     /// End vertices of open layers taken out to meet their target (SimplifyParams::trim_ends).
+    /// `restored` above is counted before them.
     std::size_t trimmed_ends = 0;
     /// Per layer, the input index of every output vertex, in output order (a simplification
     /// keeps vertices and their order; InputSides::renumbered() takes it).
