@@ -153,7 +153,10 @@ SimplifyReport simplify(Scene& scene, const SimplifyParams& params, const Progre
     bool above_target = false;
     for (std::size_t l = 0; l < out.size(); ++l)
         above_target = above_target || out.layer(l).points.size() > live.layer(l).target;
-    if (params.untangle && above_target && detail::passes(check_report)) {
+    // Not under max_error: the whole-scene removals do not bound the error (a layer then
+    // stays above its target by design).
+    if (params.untangle && params.max_error == 0.0 && above_target &&
+        detail::passes(check_report)) {
         // Layers left above their target: removals the exact check of the whole scene allows
         // where the local ones refused, then end vertices of open layers (trim_ends).
         detail::Restored thinned{out, report.origins, check_report, 0, 0};

@@ -106,3 +106,26 @@ TEST_CASE("trim_ends changes nothing in a run that meets every target", "[simpli
             CHECK(a.layer(l).points == b.layer(l).points);
     }
 }
+
+TEST_CASE("the budget steps leave max_error's bound alone", "[simplify][budget]") {
+    // With max_error a layer stays above its target where the bound says so: no whole-scene
+    // removal nor trimmed end (neither bounds the error).
+    const Scene input = read_scene(test::test_data("slices/mh_casualsuit05_y+4.00.json"));
+    SimplifyParams params;
+    params.remove = 1.0;
+    params.max_error = 0.05;
+    Scene a = input, b = input;
+    const SimplifyReport ra = simplify(a, params);
+    params.trim_ends = false;
+    simplify(b, params);
+    CHECK(ra.collision_free);
+    CHECK_FALSE(ra.targets_met);
+    CHECK(ra.trimmed_ends == 0);
+    for (std::size_t l = 0; l < input.size(); ++l) {
+        CHECK(a.layer(l).points == b.layer(l).points);
+        if (!input.layer(l).closed) {
+            CHECK(a.layer(l).points.front() == input.layer(l).points.front());
+            CHECK(a.layer(l).points.back() == input.layer(l).points.back());
+        }
+    }
+}

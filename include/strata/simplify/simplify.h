@@ -53,7 +53,8 @@ struct SimplifyParams {
     /// it crosses nothing new and keeps every gap, but it is shorter (an open piece wrapped
     /// around another layer, whose wrap needs more vertices than its target, loses its ends
     /// instead). false: open layers keep both ends, whatever their target. No effect on a run
-    /// that meets every target.
+    /// that meets every target, nor with `max_error` (whose layers stay above their target
+    /// where the error bound says so).
     bool trim_ends = true;
     std::uint64_t seed = 1;  ///< Seed of the random decimator.
     bool untangle = true;    ///< false: naive decimation (the paper's left-hand images).
