@@ -24,8 +24,6 @@ class LivePolylines {
     const LiveSegmentGrid& grid() const { return grid_; }
     /// Vertex v of layer l is not to be removed any more.
     void lock(std::size_t l, std::size_t v) { layers_[l].locked[v] = 1; }
-    /// Vertex v of layer l may be tried again.
-    void unlock(std::size_t l, std::size_t v) { layers_[l].locked[v] = 0; }
 
     /// Takes alive vertex v (not an end of an open layer) out: its neighbours are joined.
     void unlink(std::size_t l, std::size_t v);

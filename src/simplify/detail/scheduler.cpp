@@ -35,9 +35,9 @@ Scheduler::Scheduler(const SimplifyParams& params, LivePolylines& live,
 
 SimplifyReport Scheduler::run(const ProgressFn& progress) {
     const auto start_all = Clock::now();
-    to_remove_ = 0;
+    std::size_t to_remove = 0;
     for (std::size_t l = 0; l < live_.size(); ++l)
-        to_remove_ += live_.layer(l).alive_count - live_.layer(l).target;
+        to_remove += live_.layer(l).alive_count - live_.layer(l).target;
     auto push_all = [&](bool above_target_only) {
         const auto start = Clock::now();
         for (std::size_t l = 0; l < live_.size(); ++l)
@@ -46,6 +46,7 @@ SimplifyReport Scheduler::run(const ProgressFn& progress) {
         report_.seconds_decimate += seconds_since(start);
     };
     push_all(false);
+    std::size_t last_reported = 0;
     // Deferred schedule: a first sweep removes what needs no untangling; a second one
     // untangles, over the layers still above their target only.
     defer_ = params_.untangle && params_.schedule == UntangleSchedule::Deferred;
@@ -54,76 +55,43 @@ SimplifyReport Scheduler::run(const ProgressFn& progress) {
             defer_ = false;
             push_all(true);
         }
-        drain(progress);
+        for (;;) {
+            if (queue_.empty()) {
+                flush();  // its commits may bring new candidates
+                if (queue_.empty()) break;
+            }
+            const Candidate c = queue_.top();
+            queue_.pop();
+            const std::size_t l = c.layer, v = c.vertex;
+            const WorkLayer& w = live_.layer(l);
+            if (c.version != version_[l][v]) continue;
+            if (!removable(l, v) || w.alive_count <= w.target) {
+                // A waiting job's removal on this layer may yet be refused and give its vertex
+                // back: keep the candidate until the batch has run.
+                if (w.alive[v] && !w.locked[v] && waits_on(l)) held_.push_back(c);
+                continue;
+            }
+            const std::size_t a = w.prev[v], b = w.next[v];
+            if (params_.max_error > 0.0 && span_error(view(l), a, b) > params_.max_error) {
+                live_.lock(l, v);
+                continue;
+            }
+            if (batching())
+                remove_batched(c);
+            else
+                count(try_remove(l, v), l, v);
+            if (progress && (done_ - last_reported) * 100 >= to_remove) {
+                last_reported = done_;
+                if (!progress("simplify", to_remove ? static_cast<double>(done_) /
+                                                          static_cast<double>(to_remove)
+                                                    : 1.0))
+                    throw Cancelled();
+            }
+        }
     }
-    if (params_.untangle) retry_refused(progress);
     if (progress && !progress("simplify", 1.0)) throw Cancelled();
     report_.seconds_total = seconds_since(start_all);
     return report_;
-}
-
-// Tries the queued candidates until the queue is empty.
-void Scheduler::drain(const ProgressFn& progress) {
-    for (;;) {
-        if (queue_.empty()) {
-            flush();  // its commits may bring new candidates
-            if (queue_.empty()) break;
-        }
-        const Candidate c = queue_.top();
-        queue_.pop();
-        const std::size_t l = c.layer, v = c.vertex;
-        const WorkLayer& w = live_.layer(l);
-        if (c.version != version_[l][v]) continue;
-        if (!removable(l, v) || w.alive_count <= w.target) {
-            // A waiting job's removal on this layer may yet be refused and give its vertex
-            // back: keep the candidate until the batch has run.
-            if (w.alive[v] && !w.locked[v] && waits_on(l)) held_.push_back(c);
-            continue;
-        }
-        const std::size_t a = w.prev[v], b = w.next[v];
-        if (params_.max_error > 0.0 && span_error(view(l), a, b) > params_.max_error) {
-            live_.lock(l, v);
-            continue;
-        }
-        if (batching())
-            remove_batched(c);
-        else
-            count(try_remove(l, v), l, v);
-        if (progress && (done_ - last_reported_) * 100 >= to_remove_) {
-            last_reported_ = done_;
-            if (!progress("simplify",
-                          to_remove_ ? static_cast<double>(done_) / static_cast<double>(to_remove_)
-                                     : 1.0))
-                throw Cancelled();
-        }
-    }
-}
-
-// A refused removal locks its vertex for the rest of the run, though what refused it (the
-// chord to the neighbours of then, the untangling around it) changes as the layer loses
-// vertices: a layer left above its target gets its locked vertices tried again, at their new
-// cost and with their new neighbours, by the same checks, while that removes some. Runs only
-// where a layer is still above its target: a run that meets every target is not changed.
-void Scheduler::retry_refused(const ProgressFn& progress) {
-    for (;;) {
-        bool tried = false;
-        for (std::size_t l = 0; l < live_.size(); ++l) {
-            const WorkLayer& w = live_.layer(l);
-            if (w.alive_count <= w.target) continue;
-            for (std::size_t v = 0; v < w.alive.size(); ++v)
-                if (w.alive[v] && w.locked[v]) {
-                    live_.unlock(l, v);
-                    push(l, v);
-                    tried = true;
-                }
-        }
-        if (!tried) break;
-        const std::size_t before = done_;
-        retrying_ = true;
-        drain(progress);
-        retrying_ = false;
-        if (done_ == before) break;
-    }
 }
 
 DecimationView Scheduler::view(std::size_t l) const {
@@ -165,10 +133,8 @@ void Scheduler::count(Outcome outcome, std::size_t l, std::size_t v) {
             break;
         case Outcome::Refused:
             live_.lock(l, v);
-            if (!retrying_) {  // a vertex refused again is counted once
-                ++report_.refused;
-                ++report_.layers[l].refused;
-            }
+            ++report_.refused;
+            ++report_.layers[l].refused;
             break;
     }
 }

@@ -48,8 +48,6 @@ class Scheduler {
   private:
     enum class Outcome { Removed, Deferred, Refused };
 
-    void drain(const ProgressFn& progress);
-    void retry_refused(const ProgressFn& progress);
     DecimationView view(std::size_t l) const;
     bool removable(std::size_t l, std::size_t v) const;
     void push(std::size_t l, std::size_t v);
@@ -77,7 +75,6 @@ class Scheduler {
     std::priority_queue<Candidate, std::vector<Candidate>, std::greater<Candidate>> queue_;
     std::vector<std::vector<std::uint32_t>> version_;  // per vertex: of its latest candidate
     bool defer_ = false;        // this sweep sets removals that need untangling aside
-    bool retrying_ = false;     // retry_refused() is trying locked vertices again
     std::vector<Job> pending_;  // the batch
     struct Touched {
         Box2 box;                     // a removal made while jobs waited
@@ -88,9 +85,7 @@ class Scheduler {
     // Candidates of layers that looked done while a removal on them waited in the batch (it
     // may be refused): queued again after the batch, without counting towards its size.
     std::vector<Candidate> held_;
-    std::size_t done_ = 0;              // removals kept
-    std::size_t to_remove_ = 0;         // removals the targets ask for
-    std::size_t last_reported_ = 0;     // done_ at the last progress report
+    std::size_t done_ = 0;  // removals kept
     SimplifyReport report_;
 };
 
