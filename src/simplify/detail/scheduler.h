@@ -85,7 +85,7 @@ class Scheduler {
     // Candidates of layers that looked done while a removal on them waited in the batch (it
     // may be refused): queued again after the batch, without counting towards its size.
     std::vector<Candidate> held_;
-    std::size_t done_ = 0;  // removals kept
+    std::size_t done_ = 0;              // removals kept
     SimplifyReport report_;
 };
 
