@@ -134,6 +134,12 @@ signed char centroid_side(const Layer& layer, const Layer& other) {
     return static_cast<signed char>(side);
 }
 
+// The diagonal of `layer`'s bounding box.
+double diagonal(const Layer& layer) {
+    const Vec2 size = layer.bounds().size();
+    return std::hypot(size.x, size.y);
+}
+
 }  // namespace
 
 InputSides InputSides::by_region(const Scene& scene) const {
@@ -167,8 +173,12 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                 // A closed layer all of whose vertices form one region (a loop within reach
                 // of the other layer, e.g. a cord in a fold) and whose vertices disagree: the
                 // side its shape lies on (its vertex centroid's), not its vertices' vote.
+                // Only for a loop at most half the open layer's size (bounding-box
+                // diagonals), one that a fold of it can hold: a loop about as large as the
+                // open layer is wrapped by all of it (a skirt's tier inside a tier left open
+                // at a seam), and its centroid's closest point there says nothing.
                 if (layer.closed && r.count == n && r.plus > 0 && r.minus > 0 &&
-                    !scene.layer(b).closed) {
+                    !scene.layer(b).closed && diagonal(layer) <= 0.5 * diagonal(scene.layer(b))) {
                     const signed char bulk = centroid_side(layer, scene.layer(b));
                     if (bulk != 0) side = bulk;
                 }
