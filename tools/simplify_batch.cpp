@@ -202,8 +202,11 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
     starts.push_back(input);
     Scene scene;
     CheckReport after;
-    for (const Scene& start : starts) {
-        scene = untangle_input(start, u, info, after);
+    for (std::size_t i = 0; i < starts.size(); ++i) {
+        // The other readings of the input's regions (a last resort, up to 8 more tries) only
+        // on the last start: the gapped one fails fast where the gaps ask for more room.
+        u.other_readings = i + 1 < starts.size() ? 0 : UntangleParams{}.other_readings;
+        scene = untangle_input(starts[i], u, info, after);
         if (after.is_collision_free()) break;
     }
     if (!after.is_collision_free())

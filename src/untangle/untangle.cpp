@@ -404,13 +404,12 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         return report;
     }
     // Neither is clean: the other readings of the regions whose recorded sides disagree
-    // (InputSides::region_alternatives(), at most kAlternatives of them, best fitting first:
-    // at most twice the four tries above), each tried once, then once more without
-    // self-crossings made (as above); of the clean results of the first round that has one,
-    // the one that moves the input least.
-    constexpr std::size_t kAlternatives = 4;
-    std::vector<InputSides> others = recorded.region_alternatives(scene);
-    if (others.size() > kAlternatives) others.resize(kAlternatives);
+    // (InputSides::region_alternatives(), at most params.other_readings of them, best fitting
+    // first), each tried once, then once more without self-crossings made (as above); of the
+    // clean results of the first round that has one, the one that moves the input least.
+    std::vector<InputSides> others;
+    if (params.other_readings > 0) others = recorded.region_alternatives(scene);
+    if (others.size() > params.other_readings) others.resize(params.other_readings);
     for (bool keep_simple : {false, true}) {
         std::size_t best = others.size();
         Scene best_scene;

@@ -77,6 +77,12 @@ struct UntangleParams {
     /// tunnels or crosses. The projection takes the crossings out, this stage brings the
     /// gaps. false: projection and shape matching only (the paper).
     bool finish_separations = true;
+    /// untangle_inferring_sides() only: when neither the inferred sides nor the global order
+    /// come out clean, at most this many other readings of the input's regions are tried
+    /// (InputSides::region_alternatives(), two tries each). 0: none (a caller with another
+    /// attempt of its own left, e.g. strata simplify's untangling of a crossing input with
+    /// the gap rule before the one without it).
+    std::size_t other_readings = 4;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
     /// queries as fast (docs/field.md, README "Benchmarks").
