@@ -22,13 +22,16 @@ removal=${2:-0.9}
 [ -d "$data" ] || { echo "garments.sh: no garments folder at $data (skipped)" >&2; exit 77; }
 mkdir -p "$out"
 
+# elapsed T0: wall seconds since T0 (an $EPOCHREALTIME), to the hundredth.
+elapsed() { awk -v a="$1" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }'; }
+
 # slice_outfit NAME STEP STRATA-SLICE-ARGS...
 rows=()
 slice_outfit() {
   local name=$1 step=$2
   shift 2
   rm -rf "${out:?}/$name"
-  local t0=$SECONDS
+  local t0=$EPOCHREALTIME
   "$strata" slice "$@" --every "$step" --prefix "$name" -o "$out/$name" > "$out/$name.slice.log" 2> "$out/$name.slice.err"
   local slices=0 layers=0 vertices=0 crossing=0 nesting=0 links=0 welded
   welded=$(grep -c '^  welded: ' "$out/$name.slice.log" || true)
@@ -50,14 +53,15 @@ slice_outfit() {
       nesting=$((nesting + 1))
     fi
   done
-  rows+=("$(printf '%-20s %6d %7d %9d %7d %7d %10d %9d %6ds' "$name" "$slices" "$layers" "$vertices" "$links" \
-            "$welded" "$crossing" "$nesting" $((SECONDS - t0)))")
+  rows+=("$(printf '%-20s %6d %7d %9d %7d %7d %10d %9d %6ss' "$name" "$slices" "$layers" "$vertices" "$links" \
+            "$welded" "$crossing" "$nesting" "$(elapsed "$t0")")")
   # Simplify the whole folder at $removal (batch, parallel over slices).
-  t0=$SECONDS
+  t0=$EPOCHREALTIME
   rm -rf "${out:?}/$name-simplified"
   "$strata" simplify "$out/$name" -o "$out/$name-simplified" --remove "$removal" --compare-naive \
     --report "$out/$name.simplify.json" > "$out/$name.simplify.log" 2> "$out/$name.simplify.err" || true
-  local seconds=$((SECONDS - t0)) gaps
+  local seconds gaps
+  seconds=$(elapsed "$t0")
   # Smallest gap after / gap before over the near pairs of every simplified slice.
   gaps=$(python3 "$root/bench/gap_ratios.py" "$out/$name" "$out/$name-simplified" | tee "$out/$name.gaps.log" |
          sed -nE 's/^smallest ratio ([0-9.inf]+); pairs below 0.9: ([0-9]+).*/\1 \2/p')
@@ -108,6 +112,8 @@ echo
 printf '%-20s %6s %9s %6s %9s %8s %9s %8s %8s %8s %8s %8s %6s %9s %5s %7s %s\n' outfit slices untangled failed vertices \
   after "naive-x" "strata-x" tangled refused "sl-5%" "over-5%" ends "gap-ratio" "<0.9" time bad
 for r in "${srows[@]}"; do echo "$r"; done
+echo "simplification of every slice: $(for r in "${srows[@]}"; do awk '{print $16}' <<< "$r"; done |
+  awk '{sub(/s$/, ""); s += $1} END {printf "%.2f", s}') s in all (column time: wall seconds of the outfit's batch, 2 threads, naive run included)"
 echo "untangled: inputs that crossed, untangled before simplifying; failed: not simplified (the"
 echo "reason is in the .simplify.json: e.g. a layer that crosses itself cannot be untangled);"
 echo "naive-x / strata-x: crossings after naive decimation / after strata; tangled: outputs not collision-free;"
