@@ -92,6 +92,15 @@ TEST_CASE("by_region: a closed loop within reach takes the side of its bulk, not
     const std::vector<InputSides> others = recorded.region_alternatives(scene);
     REQUIRE(others.size() == 1);
     CHECK(sides_of(others.front(), scene, 0, 1) == "+++++");
+
+    // A loop as wide as the open layer is long (diagonal 8.1 against 10: more than half of
+    // it), wrapped by all of it rather than held in a fold: it keeps its vertices' vote.
+    Layer wide_a = a;
+    wide_a.points = {{1.0, -0.02}, {5.0, -0.02}, {9.0, -0.02}, {9.0, 1.0}, {1.0, 1.0}};
+    const Scene wide({wide_a, b});
+    const InputSides wide_recorded = record_input_sides(wide);
+    REQUIRE(sides_of(wide_recorded, wide, 0, 1) == "+++--");
+    CHECK(sides_of(wide_recorded.by_region(wide), wide, 0, 1) == "+++++");
 }
 
 TEST_CASE("untangle_inferring_sides keeps a cord in its collar's fold (its bulk's side)",
@@ -149,8 +158,13 @@ TEST_CASE("untangle_inferring_sides keeps a roll whose bend the decimation cut",
         CHECK(report.inferred_sides);
         CHECK(!kept.empty());
         INFO("reading " << report.sides_reading);
-        if (c.family == SceneFamily::ShirtRoll)  // clean only by another reading of its regions
+        if (c.family == SceneFamily::ShirtRoll) {  // clean only by another reading of its regions
             CHECK(report.sides_reading > 0);
+            UntangleParams none;
+            none.other_readings = 0;
+            Scene without = tangled;
+            CHECK_FALSE(untangle_inferring_sides(without, none).collision_free);
+        }
         const CheckReport check = check_scene(out, scoring);
         CHECK(check.is_collision_free());
         CHECK(check.nesting_violation_count == 0);  // the roll (or the fold) kept
