@@ -60,6 +60,37 @@ struct Restorable {
     std::size_t layer, index;  // index: in the restored scene's layer
 };
 
+// The scene of `input`'s kind with, per layer, the vertices of `base` whose `kept` flag is set;
+// checked (`params`, the sides renumbered): true and `result` replaced if it passes.
+bool take_if_passes(const Scene& input, const Scene& base,
+                    const std::vector<std::vector<std::size_t>>& base_origins,
+                    const std::vector<std::vector<char>>& kept, CheckParams params,
+                    const InputSides& sides, Restored& result) {
+    const std::size_t layers = base.size();
+    std::vector<Layer> thinned = base.layers();
+    std::vector<std::vector<std::size_t>> origins(layers);
+    for (std::size_t l = 0; l < layers; ++l) {
+        thinned[l].points.clear();
+        for (std::size_t k = 0; k < kept[l].size(); ++k)
+            if (kept[l][k]) {
+                thinned[l].points.push_back(base.layer(l).points[k]);
+                origins[l].push_back(base_origins[l][k]);
+            }
+    }
+    Scene scene = like_input(input, std::move(thinned));
+    // The Scene drops a point equal to its neighbour: then the origins no longer match.
+    for (std::size_t l = 0; l < layers; ++l)
+        if (scene.layer(l).points.size() != origins[l].size()) return false;
+    const InputSides renumbered = sides.renumbered(origins);
+    params.input_sides = &renumbered;
+    CheckReport check = check_scene(scene, params);
+    if (!passes(check)) return false;
+    result.scene = std::move(scene);
+    result.origins = std::move(origins);
+    result.check = std::move(check);
+    return true;
+}
+
 // Takes vertices out of the layers of `result` above their target (`targets`) as long as the
 // exact check still passes: first those that came back from removal (`came_back`, per layer and
 // vertex of result.scene), then the others (which the local checks may have kept for want of a
@@ -106,26 +137,8 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
             taken.push_back(i);
         }
         if (taken.empty()) return true;
-        std::vector<Layer> thinned = base.layers();
-        std::vector<std::vector<std::size_t>> origins(layers);
-        for (std::size_t l = 0; l < layers; ++l) {
-            thinned[l].points.clear();
-            for (std::size_t k = 0; k < kept[l].size(); ++k)
-                if (kept[l][k]) {
-                    thinned[l].points.push_back(base.layer(l).points[k]);
-                    origins[l].push_back(base_origins[l][k]);
-                }
-        }
-        Scene scene = like_input(input, std::move(thinned));
-        // The Scene drops a point equal to its neighbour: then the origins no longer match.
-        bool matched = true;
-        for (std::size_t l = 0; l < layers; ++l)
-            matched = matched && scene.layer(l).points.size() == origins[l].size();
-        const InputSides renumbered = matched ? sides.renumbered(origins) : InputSides{};
-        params.input_sides = &renumbered;
         ++checks;
-        CheckReport check = matched ? check_scene(scene, params) : CheckReport{};
-        if (!matched || !passes(check)) {
+        if (!take_if_passes(input, base, base_origins, kept, params, sides, result)) {
             for (std::size_t i : taken) kept[candidates[i].layer][candidates[i].index] = 1;
             return false;
         }
@@ -133,9 +146,6 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
             --spare[candidates[i].layer];
             if (!candidates[i].kept_before) --result.restored;
         }
-        result.scene = std::move(scene);
-        result.origins = std::move(origins);
-        result.check = std::move(check);
         return true;
     };
     std::vector<std::pair<std::size_t, std::size_t>> groups{{0, candidates.size()}};
@@ -147,37 +157,6 @@ void thin(const Scene& input, Restored& result, const std::vector<std::vector<ch
         groups.push_back({middle, end});  // after the first half
         groups.push_back({begin, middle});
     }
-}
-
-// The scene of `input`'s kind with, per layer, the vertices of `base` whose `kept` flag is set;
-// checked (`params`, the sides renumbered): true and `result` replaced if it passes.
-bool take_if_passes(const Scene& input, const Scene& base,
-                    const std::vector<std::vector<std::size_t>>& base_origins,
-                    const std::vector<std::vector<char>>& kept, CheckParams params,
-                    const InputSides& sides, Restored& result) {
-    const std::size_t layers = base.size();
-    std::vector<Layer> thinned = base.layers();
-    std::vector<std::vector<std::size_t>> origins(layers);
-    for (std::size_t l = 0; l < layers; ++l) {
-        thinned[l].points.clear();
-        for (std::size_t k = 0; k < kept[l].size(); ++k)
-            if (kept[l][k]) {
-                thinned[l].points.push_back(base.layer(l).points[k]);
-                origins[l].push_back(base_origins[l][k]);
-            }
-    }
-    Scene scene = like_input(input, std::move(thinned));
-    // The Scene drops a point equal to its neighbour: then the origins no longer match.
-    for (std::size_t l = 0; l < layers; ++l)
-        if (scene.layer(l).points.size() != origins[l].size()) return false;
-    const InputSides renumbered = sides.renumbered(origins);
-    params.input_sides = &renumbered;
-    CheckReport check = check_scene(scene, params);
-    if (!passes(check)) return false;
-    result.scene = std::move(scene);
-    result.origins = std::move(origins);
-    result.check = std::move(check);
-    return true;
 }
 
 bool above_targets(const Scene& scene, const std::vector<std::size_t>& targets) {
