@@ -153,6 +153,8 @@ cli::SimplifyOptions simplify_options(const py::dict& kw) {
             o.thickness = v.cast<double>();
         else if (key == "keep_gaps")
             p.keep_input_gaps = v.cast<double>();
+        else if (key == "trim_ends")
+            p.trim_ends = v.cast<bool>();
         else if (key == "global_untangle")
             p.global = v.cast<bool>();
         else if (key == "untangle")
@@ -380,6 +382,7 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("raised_separations", &SimplifyReport::raised_separations)
         .def_readonly("rolled_vertices", &SimplifyReport::rolled_vertices)
         .def_readonly("restored", &SimplifyReport::restored)
+        .def_readonly("trimmed_ends", &SimplifyReport::trimmed_ends)
         .def_readonly("crossings", &SimplifyReport::crossings)
         .def_readonly("self_crossings", &SimplifyReport::self_crossings)
         .def_readonly("nesting_violations", &SimplifyReport::nesting_violations)

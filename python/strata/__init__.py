@@ -148,6 +148,7 @@ def simplify(
     untangle_batch: int = 16,
     n_out: int = 7,
     keep_gaps: float = 0.9,
+    trim_ends: bool = True,
     thickness: float = 0.0,
     backend: str = "indexed",
     alpha: Optional[float] = None,
@@ -181,6 +182,9 @@ def simplify(
       n_out: N_out, fixed collar vertices around each piece (7).
       keep_gaps: share of the smallest input gap kept by pairs of layers whose thicknesses
         require nothing, [0, 1], 0 = off (``--keep-gaps``, 0.9).
+      trim_ends: a layer left above its target by refused removals may lose end vertices of
+        its open pieces, where the exact check passes (``report.trimmed_ends``); False keeps
+        every end (``--no-trim-ends``).
       thickness: thickness given to layers of thickness 0, scene units (0: none).
       backend: field evaluation, "indexed" (default), "exact" or "grid".
       alpha, beta: shape-matching stiffness and quadratic share, [0, 1] (0.8, 0.9).
@@ -210,6 +214,7 @@ def simplify(
             untangle_batch=untangle_batch,
             n_out=n_out,
             keep_gaps=keep_gaps,
+            trim_ends=trim_ends,
             thickness=thickness,
             backend=backend,
             alpha=alpha,

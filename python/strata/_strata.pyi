@@ -120,6 +120,7 @@ class SimplifyReport:
     raised_separations: int
     rolled_vertices: int  #: Output vertices kept on a rolled side, as in the input.
     restored: int  #: Input vertices put back by the last resort (the whole-result check failed).
+    trimmed_ends: int  #: End vertices of open layers taken out to meet a target (``trim_ends``).
     crossings: int  #: Final exact check of the output: crossings between layers.
     self_crossings: int
     nesting_violations: int
