@@ -4,6 +4,7 @@
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
 #include "untangle/detail/engine.h"
 
 #include <tbb/task_group.h>
@@ -199,6 +200,28 @@ std::vector<Vec2> tangents_along(const Layer& layer, std::size_t count) {
 std::vector<int> untangling_outside_sides(const Scene& scene) {
     std::vector<int> sides = outside_sides(scene);
     const std::size_t n = scene.size();
+    // An open layer with neighbours both under and over it, whose neighbours' sides (within
+    // the reach of record_input_sides()) under it and over it say opposite outsides: both
+    // counted together (the vote counts the layers under it alone unless they tie). A
+    // decimation that scatters the vertices on one side leaves the other's count standing.
+    std::optional<InputSides> recorded;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (scene.layer(i).closed || scene.inner_of(i).empty() || scene.outer_of(i).empty())
+            continue;
+        if (!recorded) recorded = record_input_sides(scene);
+        auto tally = [&](const std::vector<std::size_t>& layers, int sign) {
+            long vote = 0;
+            for (std::size_t j : layers)
+                for (std::size_t k = 0; k < scene.layer(j).points.size(); ++k)
+                    vote += sign * recorded->side(j, k, i);
+            return vote;
+        };
+        const long under = tally(scene.inner_of(i), -1), over = tally(scene.outer_of(i), 1);
+        if ((under > 0 && over < 0) || (under < 0 && over > 0)) {
+            const long both = under + over;
+            if (both != 0) sides[i] = both > 0 ? 1 : -1;
+        }
+    }
     // An open layer directly over a closed one that runs around it (the mean, weighted by
     // length, of the sine between its segments and the direction from the closed layer's
     // vertex centroid beyond kAround): outside away from that centroid, whatever the vote.

@@ -172,3 +172,45 @@ TEST_CASE("untangle_inferring_sides keeps a roll whose bend the decimation cut",
               0.9 * std::min(1.0, check_scene(input).min_separation_ratio));
     }
 }
+
+TEST_CASE("untangling_outside_sides: a layer outvoted by the tangle under it, over it a clear vote",
+          "[untangle][sides]") {
+    // A closed body, an open shirt over it and an open jacket over the shirt, both running +x.
+    // Untangled, the body's top lies under the shirt. Tangled, 6 of its 10 top vertices went
+    // across the shirt: the shirt's vote (the body's vertices) turns it inside out, while every
+    // vertex of the jacket over it says the other side. Counted together, the shirt keeps its
+    // outside; alone, its vote ties with the jacket's along their chain (they run along each
+    // other) and the tie took the shirt's, turning the jacket inside out too.
+    auto scene = [](bool tangled) {
+        std::vector<Vec2> body{{10.5, -3.0}};
+        for (int k = 10; k >= 0; --k) {
+            const bool across = tangled && k % 5 != 0 && k % 5 != 2;  // 6 of 10 over the shirt
+            body.push_back(Vec2(k == 10 ? 10.5 : k == 0 ? -0.5 : k - 0.5, across ? 1.2 : 0.6));
+        }
+        body.push_back(Vec2(-0.5, -3.0));
+        std::vector<Vec2> shirt, jacket;
+        for (int k = 0; k <= 10; ++k) {
+            shirt.push_back(Vec2(k, 1.0));
+            jacket.push_back(Vec2(k, 1.4));
+        }
+        Layer b, s, j;
+        b.name = "body";
+        b.points = body;
+        b.closed = true;
+        s.name = "shirt";
+        s.points = shirt;
+        j.name = "jacket";
+        j.points = jacket;
+        return Scene({b, s, j});
+    };
+    const Scene input = scene(false);
+    const Scene tangled = scene(true);
+    const std::vector<int> original = outside_sides(input);
+    REQUIRE(check_scene(input).crossing_count == 0);
+    REQUIRE(check_scene(tangled).crossing_count > 0);
+    CHECK(outside_sides(tangled)[1] != original[1]);  // the shirt's vote, outvoted
+    CHECK(outside_sides(tangled)[2] == original[2]);  // the jacket's, clear
+    CHECK(untangling_outside_sides(tangled) == original);
+    // Untangled, nothing changes: the votes under and over every layer agree.
+    CHECK(untangling_outside_sides(input) == original);
+}

@@ -159,7 +159,10 @@ struct UntangleReport {
 /// majority of the chain's votes (a tie: its lowest-index layer's). Where they agree (an
 /// untangled scene), they are returned as they are. Layers with a rolled part run along each
 /// other less (0.38-0.65 on strata_bench_untangle's rolled families) and are left to their
-/// own votes. docs/untangle.md, "Outside sides of a tangled scene".
+/// own votes. First of all, an open layer with neighbours both under and over it whose
+/// neighbours' recorded sides (record_input_sides()) under it and over it say opposite outsides
+/// takes the sign of both counts together (a decimation that scatters one side's vertices
+/// leaves the other's count standing). docs/untangle.md, "Outside sides of a tangled scene".
 std::vector<int> untangling_outside_sides(const Scene& scene);
 
 /// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
