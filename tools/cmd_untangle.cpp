@@ -158,7 +158,9 @@ Run add_untangle_command(CLI::App& app) {
                   {"check", r.seconds_check},
                   {"total", seconds}}},
                 {"finishes", r.finishes},
-                {"finish_moves", r.finish_moves}};
+                {"finish_moves", r.finish_moves},
+                {"kept_simple", r.kept_simple},
+                {"long_rounds", r.long_rounds}};
             if (params.input_sides)
                 j["sides"] = {{"from", reference ? opt->reference : "inferred"},
                               {"rolled_vertices", r.rolled_vertices},

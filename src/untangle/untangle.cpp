@@ -366,7 +366,32 @@ UntangleReport after(UntangleReport second, const UntangleReport& first) {
 
 }  // namespace
 
-UntangleReport untangle(Scene& scene, const UntangleParams& given, const ProgressFn& progress) {
+namespace {
+
+// `retry`: when the tries with params fail, they run again with long rounds (UntangleParams::
+// long_rounds_factor) and the first clean result is kept; the report counts both.
+template <class Tries>
+UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, Tries&& tries) {
+    const Scene input = scene;
+    UntangleReport report = tries(scene, params);
+    if (report.collision_free || params.long_rounds_factor <= 1) return report;
+    UntangleParams longer = params;
+    longer.gradient_steps = params.gradient_steps * params.long_rounds_factor;
+    longer.long_rounds_factor = 1;
+    Scene attempt = input;
+    UntangleReport second = tries(attempt, longer);
+    if (!second.collision_free) {
+        report.passes += second.passes;
+        report.rounds += second.rounds;
+        return report;
+    }
+    scene = std::move(attempt);
+    second.long_rounds = true;
+    return after(second, report);
+}
+
+UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
+                              const ProgressFn& progress) {
     const UntangleParams params = with_outside_sides(scene, given);
     const Scene input = scene;
     UntangleReport report = untangle_once(scene, params, progress, false);
@@ -380,10 +405,8 @@ UntangleReport untangle(Scene& scene, const UntangleParams& given, const Progres
     return after(second, report);
 }
 
-UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
-                                        const ProgressFn& progress, InputSides* kept) {
-    if (params.input_sides && !params.input_sides->empty())
-        return untangle(scene, params, progress);
+UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
+                                     const ProgressFn& progress, InputSides* kept) {
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
     const InputSides recorded = record_input_sides(scene);
@@ -460,6 +483,23 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     }
     scene = std::move(first_scene);
     return first;
+}
+
+}  // namespace
+
+UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
+    return with_long_rounds(scene, params, [&](Scene& s, const UntangleParams& p) {
+        return untangle_tries(s, p, progress);
+    });
+}
+
+UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
+                                        const ProgressFn& progress, InputSides* kept) {
+    if (params.input_sides && !params.input_sides->empty())
+        return untangle(scene, params, progress);
+    return with_long_rounds(scene, params, [&](Scene& s, const UntangleParams& p) {
+        return inferring_sides_tries(s, p, progress, kept);
+    });
 }
 
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,
