@@ -488,9 +488,7 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
 }  // namespace
 
 UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
-    return with_long_rounds(scene, params, [&](Scene& s, const UntangleParams& p) {
-        return untangle_tries(s, p, progress);
-    });
+    return untangle_tries(scene, params, progress);
 }
 
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,

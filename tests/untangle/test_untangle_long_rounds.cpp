@@ -1,6 +1,6 @@
-// UntangleParams::long_rounds_factor (issue 13): when every try of an untangling fails, the
-// tries run again with rounds of gradient_steps x the factor, so shape matching (which pulls
-// toward the tangled input) comes less often per projection step.
+// UntangleParams::long_rounds_factor (issue 13): when every try of untangle_inferring_sides()
+// fails, the tries run again with rounds of gradient_steps x the factor, so shape matching (which
+// pulls toward the tangled input) comes less often per projection step.
 
 #include "strata/geometry/checks.h"
 #include "strata/geometry/input_sides.h"
@@ -28,29 +28,29 @@ Scene naive_decimation(const Scene& input, double remove, unsigned seed) {
 
 }  // namespace
 
-TEST_CASE("untangle: longer rounds when every try fails (the S-folded stack at 95%)",
+TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded stack at 95%)",
           "[untangle]") {
-    // The benchmark's folded stack (4 layers of 300 points), 95% removed at random, seeds 3 and
-    // 8 (unseen by the benchmark, whose seed is 1): both first tries and both second tries wander
-    // for 64 passes and end tangled with 10 steps a round; with 30 they come out clean.
+    // The benchmark's folded stack (4 layers of 300 points), 95% removed at random, seed 3
+    // (unseen by the benchmark, whose seed is 1): every try wanders for 64 passes and ends
+    // tangled with 10 steps a round; with 30 they come out clean.
     FamilyParams p;
     p.layers = 4;
     const Scene input = make_scene(SceneFamily::Folded, p);
     CheckParams judged;
     judged.outside_sides = outside_sides(input);
     judged.separation_tolerance = 0.1;
-    for (unsigned seed : {3u, 8u}) {
+    for (unsigned seed : {3u}) {  // seed 8 too (docs/untangle.md), slower
         CAPTURE(seed);
         const Scene tangled = naive_decimation(input, 0.95, seed);
         REQUIRE(check_scene(tangled).crossing_count > 0);
         UntangleParams without;
         without.long_rounds_factor = 1;
         Scene failed = tangled;
-        const UntangleReport before = untangle(failed, without);
+        const UntangleReport before = untangle_inferring_sides(failed, without);
         CHECK_FALSE(before.collision_free);
         CHECK_FALSE(before.long_rounds);
         Scene out = tangled;
-        const UntangleReport report = untangle(out, UntangleParams{});
+        const UntangleReport report = untangle_inferring_sides(out, UntangleParams{});
         CHECK(report.collision_free);
         CHECK(report.long_rounds);
         CHECK(report.passes > before.passes);  // the failed tries count too
@@ -61,7 +61,8 @@ TEST_CASE("untangle: longer rounds when every try fails (the S-folded stack at 9
     }
 }
 
-TEST_CASE("untangle: a scene the first try cleans does not get the longer rounds", "[untangle]") {
+TEST_CASE("untangle_inferring_sides: a scene the first try cleans gets no longer rounds",
+          "[untangle]") {
     FamilyParams p;
     p.layers = 4;
     const Scene input = make_scene(SceneFamily::Stack, p);
@@ -70,10 +71,20 @@ TEST_CASE("untangle: a scene the first try cleans does not get the longer rounds
     Scene a = tangled, b = tangled;
     UntangleParams without;
     without.long_rounds_factor = 1;
-    const UntangleReport ra = untangle(a, UntangleParams{});
-    const UntangleReport rb = untangle(b, without);
+    const UntangleReport ra = untangle_inferring_sides(a, UntangleParams{});
+    const UntangleReport rb = untangle_inferring_sides(b, without);
     REQUIRE(ra.collision_free);
     CHECK_FALSE(ra.long_rounds);
     CHECK(ra.passes == rb.passes);
     for (std::size_t l = 0; l < a.size(); ++l) CHECK(a.layer(l).points == b.layer(l).points);
+}
+
+TEST_CASE("untangle() itself does not retry with longer rounds", "[untangle]") {
+    FamilyParams p;
+    p.layers = 4;
+    const Scene tangled = naive_decimation(make_scene(SceneFamily::Folded, p), 0.95, 3);
+    Scene out = tangled;
+    const UntangleReport report = untangle(out, UntangleParams{});
+    CHECK_FALSE(report.collision_free);
+    CHECK_FALSE(report.long_rounds);
 }

@@ -83,12 +83,13 @@ struct UntangleParams {
     /// attempt of its own left, e.g. strata simplify's untangling of a crossing input with
     /// the gap rule before the one without it).
     std::size_t other_readings = 4;
-    /// untangle() and untangle_inferring_sides(): when every try fails, all of them run once
-    /// more from the input with gradient_steps x this factor (rounds this many times longer,
-    /// so shape matching, which pulls toward the tangled input, comes this many times less
-    /// often per projection step); the first clean result of those is kept. <= 1: no such
+    /// untangle_inferring_sides() without params.input_sides only: when every try fails
+    /// (inferred sides, global order, other readings; first and second tries), all of them
+    /// run once more from the input with gradient_steps x this factor (rounds this many times
+    /// longer, so shape matching, which pulls toward the tangled input, comes this many times
+    /// less often per projection step); the first clean result of those is kept. <= 1: no such
     /// retry. A scene that an earlier try cleans never gets here (its output is unchanged).
-    /// docs/untangle.md, "Longer rounds when every try fails".
+    /// untangle() itself does not retry. docs/untangle.md, "Longer rounds when every try fails".
     int long_rounds_factor = 3;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
@@ -149,8 +150,9 @@ struct UntangleReport {
     /// untangle(): the first try did not come out clean, and the result is the second, from
     /// the input, in which no vertex move makes a self-crossing (passes and rounds count both).
     bool kept_simple = false;
-    /// Every try with params.gradient_steps failed, and the result is that of the retry with
-    /// params.long_rounds_factor times as many (passes and rounds count all tries).
+    /// untangle_inferring_sides(): every try with params.gradient_steps failed, and the result
+    /// is that of the retry with params.long_rounds_factor times as many (passes and rounds
+    /// count all tries).
     bool long_rounds = false;
 };
 
