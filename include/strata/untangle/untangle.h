@@ -151,8 +151,8 @@ struct UntangleReport {
     /// the input, in which no vertex move makes a self-crossing (passes and rounds count both).
     bool kept_simple = false;
     /// untangle_inferring_sides(): every try with params.gradient_steps failed, and the result
-    /// is that of the retry with params.long_rounds_factor times as many (passes and rounds
-    /// count all tries).
+    /// is that of the retry with params.long_rounds_factor times as many (passes and rounds:
+    /// the retry's plus those of the failed tries' report).
     bool long_rounds = false;
 };
 
@@ -196,7 +196,9 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// (InputSides::region_alternatives() of the input's recorded sides: a region whose vertices'
 /// sides disagree, split in two or given the other side), first as untangle()'s first
 /// try, then as its second; the first round with a clean result keeps the clean one that moves
-/// a vertex least (report.inferred_sides, `kept` those sides). With params.input_sides given,
+/// a vertex least (report.inferred_sides, `kept` those sides). When every try fails, they all
+/// run once more with params.long_rounds_factor times the gradient steps (report.long_rounds).
+/// With params.input_sides given,
 /// this is untangle(). Same params, progress and throws as
 /// untangle(). `kept`: if given, receives the inferred sides when they were kept, for judging
 /// the result (check_scene() with them and params' outside sides, or outside_sides() of the
