@@ -88,8 +88,10 @@ struct UntangleParams {
     /// run once more from the input with gradient_steps x this factor (rounds this many times
     /// longer, so shape matching, which pulls toward the tangled input, comes this many times
     /// less often per projection step); the first clean result of those is kept. <= 1: no such
-    /// retry. A scene that an earlier try cleans never gets here (its output is unchanged).
-    /// untangle() itself does not retry. docs/untangle.md, "Longer rounds when every try fails".
+    /// retry. A scene that an earlier try cleans never gets here (its output is unchanged),
+    /// nor one with rolled regions by its inferred sides (where the sides are in question,
+    /// longer rounds let a wrong reading hold). untangle() itself does not retry. docs/untangle.md,
+    /// "Longer rounds when every try fails".
     int long_rounds_factor = 3;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
