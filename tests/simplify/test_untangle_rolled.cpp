@@ -21,6 +21,7 @@
 #include <vector>
 
 using namespace strata;
+using test::naive_decimation;
 
 namespace {
 
@@ -130,19 +131,6 @@ void require_roll_kept(const RolledCase& c, const Scene& tangled, const Scene& o
     const auto [judged, on_top] = still_on_top(c, tangled, out);
     CHECK(judged > 0);
     CHECK(on_top == judged);
-}
-
-Scene naive_decimation(const Scene& input, double remove, unsigned seed,
-                       std::vector<std::vector<std::size_t>>* origins = nullptr) {
-    SimplifyParams naive;
-    naive.decimator = "random";
-    naive.seed = seed;
-    naive.remove = remove;
-    naive.untangle = false;
-    Scene out = input;
-    const SimplifyReport report = simplify(out, naive);
-    if (origins) *origins = report.origins;
-    return out;
 }
 
 bool same_points(const Scene& a, const Scene& b) {

@@ -3,10 +3,13 @@
 
 #include "strata/geometry/scene.h"
 #include "strata/simplify/scene_families.h"
+#include "strata/simplify/simplify.h"
 
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace strata::test {
 
@@ -37,6 +40,22 @@ Scene spiral(double turns, std::size_t points);
 /// 1 gap over [0, 8]; w(x) = 0.3 gap sin 2x; gap = gap_in_segments x 10 / (points - 1).
 /// Thickness half the gap (required separation: half the gap).
 Scene wavy_roll(std::size_t points, double gap_in_segments);
+
+/// Naive random decimation of `input` (`strata simplify --decimator random --seed N
+/// --no-untangle`), as strata_bench_untangle tangles its scenes; `origins`: if given, the input
+/// index of every output vertex (inline: only the tests that use it link the simplify module).
+inline Scene naive_decimation(const Scene& input, double remove, unsigned seed = 1,
+                              std::vector<std::vector<std::size_t>>* origins = nullptr) {
+    SimplifyParams naive;
+    naive.decimator = "random";
+    naive.seed = seed;
+    naive.remove = remove;
+    naive.untangle = false;
+    Scene out = input;
+    SimplifyReport report = simplify(out, naive);
+    if (origins) *origins = std::move(report.origins);
+    return out;
+}
 
 /// make_scene(SceneFamily::RolledBoth) with `points` and `gap_in_segments` (inline: only the
 /// tests that use it link the simplify module).

@@ -7,6 +7,7 @@
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
 #include "strata/untangle/untangle.h"
+#include "support/fixtures.h"
 
 #include <catch2/catch.hpp>
 
@@ -15,6 +16,7 @@
 #include <vector>
 
 using namespace strata;
+using test::naive_decimation;
 
 namespace {
 
@@ -23,17 +25,6 @@ std::string sides_of(const InputSides& sides, const Scene& scene, std::size_t a,
     std::string out;
     for (std::size_t k = 0; k < scene.layer(a).points.size(); ++k)
         out += "-0+"[sides.side(a, k, b) + 1];
-    return out;
-}
-
-// Naive random decimation, as strata_bench_untangle tangles its scenes.
-Scene naive_decimation(const Scene& input, double remove) {
-    SimplifyParams naive;
-    naive.decimator = "random";
-    naive.remove = remove;
-    naive.untangle = false;
-    Scene out = input;
-    simplify(out, naive);
     return out;
 }
 

@@ -7,26 +7,12 @@
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
 #include "strata/untangle/untangle.h"
+#include "support/fixtures.h"
 
 #include <catch2/catch.hpp>
 
 using namespace strata;
-
-namespace {
-
-// Naive random decimation, as `strata simplify --decimator random --seed N --no-untangle`.
-Scene naive_decimation(const Scene& input, double remove, unsigned seed) {
-    SimplifyParams naive;
-    naive.decimator = "random";
-    naive.seed = seed;
-    naive.remove = remove;
-    naive.untangle = false;
-    Scene out = input;
-    simplify(out, naive);
-    return out;
-}
-
-}  // namespace
+using test::naive_decimation;
 
 TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded stack at 95%)",
           "[untangle]") {
