@@ -102,13 +102,7 @@ TEST_CASE("untangle_inferring_sides keeps a cord in its collar's fold (its bulk'
     const Scene input = make_scene(SceneFamily::CollarWrap);
     for (unsigned seed : {6u, 10u}) {
         INFO("seed " << seed);
-        SimplifyParams naive;
-        naive.decimator = "random";
-        naive.remove = 0.95;
-        naive.untangle = false;
-        naive.seed = seed;
-        Scene tangled = input;
-        simplify(tangled, naive);
+        const Scene tangled = naive_decimation(input, 0.95, seed);
         const InputSides sides = InputSides::matched(record_input_sides(input), input, tangled);
         CheckParams scoring;
         scoring.outside_sides = outside_sides(input);
