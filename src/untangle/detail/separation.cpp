@@ -448,9 +448,14 @@ class Finisher {
     void try_move(std::size_t l, std::size_t v, Vec2 delta, SeparationResult& result,
                   std::vector<bool>& changed) {
         const Vec2 p = pts_[l][v];
+        bool gathered = false;
         for (int attempt = 0; attempt < 4; ++attempt, delta *= 0.5) {
             const Vec2 to = p + delta;
             if (to == p) return;
+            // The first (largest) move's box holds every later one's (p + delta / 2^k rounds
+            // between p and p + delta): its candidates serve them all.
+            if (!gathered) gather_candidates(l, v, p, to);
+            gathered = true;
             if (!is_safe(l, v, p, to)) continue;
             pts_[l][v] = to;
             cells_->moved(l, v);
@@ -461,22 +466,48 @@ class Finisher {
         ++result.refused;
     }
 
+    // The box of vertex (l, v)'s move from p to `to` with its two neighbours: what is_safe()
+    // tests lies in it.
+    Box2 move_box(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) const {
+        const std::size_t n = layer_size(l);
+        Box2 box;
+        box.extend(p);
+        box.extend(to);
+        if (closed_[l] || v > 0) box.extend(pts_[l][(v + n - 1) % n]);
+        if (closed_[l] || v + 1 < n) box.extend(pts_[l][(v + 1) % n]);
+        return box;
+    }
+
+    // A segment whose box is apart from `box` (exact comparisons, as segment_contact()'s own).
+    static bool is_apart(const Vec2& a, const Vec2& b, const Box2& box) {
+        return std::max(a.x, b.x) < box.min.x || std::min(a.x, b.x) > box.max.x ||
+               std::max(a.y, b.y) < box.min.y || std::min(a.y, b.y) > box.max.y;
+    }
+
+    // candidates_: the segments of cells_ not apart from the box of the move of vertex (l, v)
+    // from p to `to`, for is_safe() on that move or a shorter one in the same direction
+    // (nothing moves in between).
+    void gather_candidates(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) {
+        const Box2 box = move_box(l, v, p, to);
+        candidates_.clear();
+        cells_->query(box, [&](const SegId& s) {
+            if (!is_apart(cells_->start(s), cells_->end(s), box)) candidates_.push_back(s);
+        });
+    }
+
     // Exact: moving vertex (l, v) from p to `to` tunnels through nothing. The new segments
     // (prev, to) and (to, next) may meet another segment only as many times as the old ones
     // did (a vertex on the wrong side of a layer moves back over it one vertex at a time: the
     // crossing passes from one of its segments to the other), and the triangles swept
     // by the old segments must hold no other vertex; then no segment that the old ones did
     // not meet can have passed through the moving ones, and no new contact is made.
-    bool is_safe(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) {
+    // The segments tested are those of candidates_ (gather_candidates() of this move or of a
+    // longer one): every segment that may meet the move's box is among them.
+    bool is_safe(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) const {
         const std::size_t n = layer_size(l);
         const bool has_prev = closed_[l] || v > 0, has_next = closed_[l] || v + 1 < n;
         const std::size_t prev = (v + n - 1) % n, next = (v + 1) % n;
-        Box2 box;
-        box.extend(p);
-        box.extend(to);
-        if (has_prev) box.extend(pts_[l][prev]);
-        if (has_next) box.extend(pts_[l][next]);
-        bool safe = true;
+        const Box2 box = move_box(l, v, p, to);
         auto shares_end = [&](const SegId& s, std::size_t a, std::size_t b) {
             if (s.layer != l) return false;
             const std::size_t s1 = (s.index + 1) % n;
@@ -495,15 +526,12 @@ class Finisher {
         sweep_next = sweep_prev;
         if (has_prev) sweep_prev.extend(pts_[l][prev]);
         if (has_next) sweep_next.extend(pts_[l][next]);
-        cells_->query(box, [&](const SegId& s) {
-            if (!safe) return;
+        for (const SegId& s : candidates_) {
             const Vec2 a = cells_->start(s), b = cells_->end(s);
             // Everything tested below lies in `box`: the new and old segments and the swept
             // triangles. A segment whose box is apart from it can neither meet them nor have
-            // an end inside a triangle (exact comparisons, as segment_contact()'s own).
-            if (std::max(a.x, b.x) < box.min.x || std::min(a.x, b.x) > box.max.x ||
-                std::max(a.y, b.y) < box.min.y || std::min(a.y, b.y) > box.max.y)
-                return;
+            // an end inside a triangle.
+            if (is_apart(a, b, box)) continue;
             const bool with_prev = has_prev && !shares_end(s, prev, v);
             const bool with_next = has_next && !shares_end(s, v, next);
             const int now = (with_prev && meets(pts_[l][prev], to, a, b) ? 1 : 0) +
@@ -511,21 +539,21 @@ class Finisher {
             // Allowed only as often as the old segments met it.
             if (now > 0 && now > (with_prev && meets(pts_[l][prev], p, a, b) ? 1 : 0) +
                                      (with_next && meets(p, pts_[l][next], a, b) ? 1 : 0))
-                safe = false;
+                return false;
             const std::size_t ends[2] = {s.index, (s.index + 1) % layer_size(s.layer)};
-            for (std::size_t e = 0; e < 2 && safe; ++e) {
+            for (std::size_t e = 0; e < 2; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
                 const Vec2 w = pts_[s.layer][ends[e]];
                 if (!box.contains(w)) continue;
                 if (has_prev && sweep_prev.contains(w) &&
                     in_closed_triangle(p, to, pts_[l][prev], w))
-                    safe = false;
+                    return false;
                 if (has_next && sweep_next.contains(w) &&
                     in_closed_triangle(p, to, pts_[l][next], w))
-                    safe = false;
+                    return false;
             }
-        });
-        return safe;
+        }
+        return true;
     }
 
     Scene& work_;
@@ -551,6 +579,7 @@ class Finisher {
     std::optional<SegmentCells> cells_;
     std::vector<SegId> active_;  // (layer, vertex) of the vertices near the free ones
     std::vector<SegId> found_;
+    std::vector<SegId> candidates_;  // gather_candidates()
     std::vector<double> distance_;  // from the vertex relaxed to each of found_, as found
     double worst_ = 0.0;
     std::size_t wrong_side_ = 0;
