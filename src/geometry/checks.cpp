@@ -492,6 +492,76 @@ Crossing to_crossing(const Contact& c) {
     return x;
 }
 
+// The contacts among the kept segments of `indices` (every layer's) for which keep(i, s)
+// holds, in one grid over them (ids in (layer, segment) order), each pair once, in the order
+// of its first segment's id, then its second's: touch(i, s, j, t, point) for a touch (an
+// adjacent pair of one layer that folds back included) at its representative point,
+// cross(i, s, j, t, p0, p1, q0, q1) for a proper crossing of segment s of layer i (p0, p1)
+// with segment t of layer j (q0, q1). find_contacts() (every segment) and run_region() (the
+// segments near the region) share it.
+template <class Keep, class Touch, class Cross>
+void scan_contacts(const std::vector<SegmentIndex>& indices, Keep&& keep, Touch&& touch,
+                   Cross&& cross) {
+    std::vector<std::pair<std::size_t, std::size_t>> owner;
+    std::vector<Box2> boxes;
+    std::vector<double> lengths;
+    std::size_t total = 0;
+    for (std::size_t i = 0; i < indices.size(); ++i)
+        for (std::size_t s : indices[i].segments())
+            if (keep(i, s)) ++total;
+    owner.reserve(total);
+    boxes.reserve(total);
+    lengths.reserve(total);
+    Box2 all;
+    for (std::size_t i = 0; i < indices.size(); ++i)
+        for (std::size_t s : indices[i].segments()) {
+            if (!keep(i, s)) continue;
+            owner.emplace_back(i, s);
+            boxes.push_back(indices[i].box(s));
+            all.extend(boxes.back());
+            const Vec2 d = indices[i].end(s) - indices[i].start(s);
+            lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));  // sizes the cells only
+        }
+    if (owner.empty()) return;
+    std::vector<std::uint32_t> ids(owner.size());
+    for (std::size_t id = 0; id < ids.size(); ++id) ids[id] = static_cast<std::uint32_t>(id);
+    detail::UniformGrid<std::uint32_t> grid = segment_grid(all, median_of(lengths), owner.size());
+    grid.build(ids, [&](std::uint32_t id) { return boxes[id]; });
+    std::vector<std::uint32_t> hits;
+    for (std::size_t id = 0; id < owner.size(); ++id) {
+        const auto [i, s] = owner[id];
+        const SegmentIndex& a = indices[i];
+        const Vec2 p0 = a.start(s), p1 = a.end(s);
+        hits.clear();
+        // Each cell's later segments whose boxes meet this one's; a segment filed in several
+        // of these cells comes more than once: sorted, then made unique.
+        const Box2& own = boxes[id];
+        grid.query(own, [&](std::uint32_t hit) {
+            if (hit > id && boxes[hit].overlaps(own)) hits.push_back(hit);
+        });
+        std::sort(hits.begin(), hits.end());
+        hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
+        for (const std::uint32_t hit : hits) {
+            const auto [j, t] = owner[hit];
+            const SegmentIndex& b = indices[j];
+            const Vec2 q0 = b.start(t), q1 = b.end(t);
+            if (i == j && (a.next(s) == t || a.next(t) == s)) {
+                Vec2 point;
+                if ((a.next(s) == t && folds_back(p0, p1, q1, point)) ||
+                    (a.next(t) == s && folds_back(q0, q1, p1, point)))
+                    touch(i, s, j, t, point);
+                continue;
+            }
+            const SegmentContact contact = segment_contact(p0, p1, q0, q1);
+            if (contact == SegmentContact::None) continue;
+            if (contact == SegmentContact::Touch)
+                touch(i, s, j, t, touch_point(p0, p1, q0, q1));
+            else
+                cross(i, s, j, t, p0, p1, q0, q1);
+        }
+    }
+}
+
 // The partition behind RegionCheck: what may change when only vertices inside `box` move
 // (and their segments stay inside it), measured on the reference scene.
 struct RegionPlan {
@@ -620,64 +690,15 @@ class Checker {
     }
 
     void find_contacts() {
-        // One grid over the kept segments of every layer; ids follow (layer, segment) order.
-        std::vector<std::pair<std::size_t, std::size_t>> owner;
-        std::vector<Box2> boxes;
-        std::vector<double> lengths;
-        std::size_t total = 0;
-        for (std::size_t i = 0; i < n_; ++i) total += indices_[i].segments().size();
-        owner.reserve(total);
-        boxes.reserve(total);
-        lengths.reserve(total);
-        Box2 all;
-        for (std::size_t i = 0; i < n_; ++i)
-            for (std::size_t s : indices_[i].segments()) {
-                owner.emplace_back(i, s);
-                boxes.push_back(indices_[i].box(s));
-                all.extend(boxes.back());
-                const Vec2 d = indices_[i].end(s) - indices_[i].start(s);
-                lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));  // sizes the cells only
-            }
-        std::vector<std::uint32_t> ids(owner.size());
-        for (std::size_t id = 0; id < ids.size(); ++id) ids[id] = static_cast<std::uint32_t>(id);
-        detail::UniformGrid<std::uint32_t> grid =
-            segment_grid(all, median_of(lengths), owner.size());
-        auto box_of = [&](std::uint32_t id) { return boxes[id]; };
-        grid.build(ids, box_of);
-
         const std::size_t cap = params_.max_listed;
         std::vector<Contact> proper_cross, proper_self, touches;
-        std::vector<std::uint32_t> hits;
-        for (std::size_t id = 0; id < owner.size(); ++id) {
-            const auto [i, s] = owner[id];
-            const SegmentIndex& a = indices_[i];
-            const Vec2 p0 = a.start(s), p1 = a.end(s);
-            hits.clear();
-            // Each cell's later segments whose boxes meet this one's; a segment filed in
-            // several of these cells comes more than once: sorted, then made unique.
-            const Box2& own = boxes[id];
-            grid.query(own, [&](std::uint32_t hit) {
-                if (hit > id && boxes[hit].overlaps(own)) hits.push_back(hit);
-            });
-            std::sort(hits.begin(), hits.end());
-            hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
-            for (const std::uint32_t hit : hits) {
-                const auto [j, t] = owner[hit];
-                const SegmentIndex& b = indices_[j];
-                const Vec2 q0 = b.start(t), q1 = b.end(t);
-                if (i == j && (a.next(s) == t || a.next(t) == s)) {
-                    Vec2 point;
-                    if ((a.next(s) == t && folds_back(p0, p1, q1, point)) ||
-                        (a.next(t) == s && folds_back(q0, q1, p1, point)))
-                        touches.push_back({i, s, j, t, point, true});
-                    continue;
-                }
-                const SegmentContact contact = segment_contact(p0, p1, q0, q1);
-                if (contact == SegmentContact::None) continue;
-                if (contact == SegmentContact::Touch) {
-                    touches.push_back({i, s, j, t, touch_point(p0, p1, q0, q1), true});
-                    continue;
-                }
+        scan_contacts(
+            indices_, [](std::size_t, std::size_t) { return true; },
+            [&](std::size_t i, std::size_t s, std::size_t j, std::size_t t, const Vec2& point) {
+                touches.push_back({i, s, j, t, point, true});
+            },
+            [&](std::size_t i, std::size_t s, std::size_t j, std::size_t t, const Vec2& p0,
+                const Vec2& p1, const Vec2& q0, const Vec2& q1) {
                 const Contact c{i, s, j, t, crossing_point(p0, p1, q0, q1), false};
                 if (away_ && !(plan_->near_segment[i][s] && plan_->near_segment[j][t]))
                     tally_away(c);
@@ -689,8 +710,7 @@ class Checker {
                     note_meeting(i, j, c.point);
                     if (proper_cross.size() < cap) proper_cross.push_back(c);
                 }
-            }
-        }
+            });
 
         // One contact location counts once: touches of the same two layers at the same
         // representative point merge, keeping the lowest segment pair.
@@ -959,66 +979,21 @@ CheckCounts Checker::run_region(const RegionPlan& plan, const Away& away) {
     std::vector<char> met = away.met;
     // Contacts between the segments near the region, as find_contacts() finds them; of the
     // touches, those at a point in the region (the others do not change).
-    std::vector<std::pair<std::size_t, std::size_t>> owner;
-    std::vector<Box2> boxes;
-    std::vector<double> lengths;
-    Box2 all;
-    for (std::size_t i = 0; i < n_; ++i)
-        for (std::size_t s : indices_[i].segments()) {
-            if (!plan.near_segment[i][s]) continue;
-            owner.emplace_back(i, s);
-            boxes.push_back(indices_[i].box(s));
-            all.extend(boxes.back());
-            const Vec2 d = indices_[i].end(s) - indices_[i].start(s);
-            lengths.push_back(std::sqrt(d.x * d.x + d.y * d.y));
-        }
     std::vector<Contact> touches;
-    if (!owner.empty()) {
-        std::vector<std::uint32_t> ids(owner.size());
-        for (std::size_t id = 0; id < ids.size(); ++id) ids[id] = static_cast<std::uint32_t>(id);
-        detail::UniformGrid<std::uint32_t> grid =
-            segment_grid(all, median_of(lengths), owner.size());
-        grid.build(ids, [&](std::uint32_t id) { return boxes[id]; });
-        std::vector<std::uint32_t> hits;
-        for (std::size_t id = 0; id < owner.size(); ++id) {
-            const auto [i, s] = owner[id];
-            const SegmentIndex& a = indices_[i];
-            const Vec2 p0 = a.start(s), p1 = a.end(s);
-            hits.clear();
-            const Box2& own = boxes[id];
-            grid.query(own, [&](std::uint32_t hit) {
-                if (hit > id && boxes[hit].overlaps(own)) hits.push_back(hit);
-            });
-            std::sort(hits.begin(), hits.end());
-            hits.erase(std::unique(hits.begin(), hits.end()), hits.end());
-            for (const std::uint32_t hit : hits) {
-                const auto [j, t] = owner[hit];
-                const SegmentIndex& b = indices_[j];
-                const Vec2 q0 = b.start(t), q1 = b.end(t);
-                if (i == j && (a.next(s) == t || a.next(t) == s)) {
-                    Vec2 point;
-                    if (((a.next(s) == t && folds_back(p0, p1, q1, point)) ||
-                         (a.next(t) == s && folds_back(q0, q1, p1, point))) &&
-                        region.contains(point))
-                        touches.push_back({i, s, j, t, point, true});
-                    continue;
-                }
-                const SegmentContact contact = segment_contact(p0, p1, q0, q1);
-                if (contact == SegmentContact::None) continue;
-                if (contact == SegmentContact::Touch) {
-                    const Vec2 point = touch_point(p0, p1, q0, q1);
-                    if (region.contains(point)) touches.push_back({i, s, j, t, point, true});
-                    continue;
-                }
-                if (i == j) {
-                    ++counts.self_crossing_count;
-                } else {
-                    ++counts.crossing_count;
-                    met[i * n_ + j] = 1;
-                }
+    scan_contacts(
+        indices_, [&](std::size_t i, std::size_t s) { return plan.near_segment[i][s] != 0; },
+        [&](std::size_t i, std::size_t s, std::size_t j, std::size_t t, const Vec2& point) {
+            if (region.contains(point)) touches.push_back({i, s, j, t, point, true});
+        },
+        [&](std::size_t i, std::size_t, std::size_t j, std::size_t, const Vec2&, const Vec2&,
+            const Vec2&, const Vec2&) {
+            if (i == j) {
+                ++counts.self_crossing_count;
+            } else {
+                ++counts.crossing_count;
+                met[i * n_ + j] = 1;
             }
-        }
-    }
+        });
     std::sort(touches.begin(), touches.end(), [](const Contact& x, const Contact& y) {
         return std::tie(x.la, x.lb, x.point.x, x.point.y) <
                std::tie(y.la, y.lb, y.point.x, y.point.y);
