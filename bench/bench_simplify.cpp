@@ -1,8 +1,10 @@
 // Benchmarks of the collision-free simplification (issue 5), ratios measured in one run.
 //
 //   strata_bench_simplify paper [--repeat N] [--only global|local] [--stretch long|short]
+//                               [--margin M]...
 //                                           paper section 5.2: local vs global untangling
-//                                           (best of N, default 3)
+//                                           (best of N, default 3; the local box grown by
+//                                           each M, default 0.3 and 0.1)
 //   strata_bench_simplify scenes [options]  generated 5/8-layer scenes, per backend and
 //                                           schedule (options: see the usage line)
 //
@@ -75,10 +77,12 @@ long peak_rss_mb() {
 // globally and locally, 150 iterations (5 rounds of N_gd = 30) and to convergence. The
 // stretch is vertices (first, last) of the middle layer: 400-1200 (40% of it), and a short
 // one, 400-480 (4%), where the local box holds a few percent of the scene as in a
-// simplification step. Each run is repeated `repeat` times, global and local in turn, and
-// the best time of each is kept. `only`: "global" or "local" runs only that mode (profiling),
-// "" both.
-void paper(std::size_t first, std::size_t last, int repeat, const std::string& only) {
+// simplification step. The local box is the stretch's box grown by each of `margins` (scene
+// units) in turn. Each run is repeated `repeat` times, global and the local ones in turn, and
+// the best time of each is kept. `only`: "global" or "local" runs only that mode
+// (profiling), "" both.
+void paper(std::size_t first, std::size_t last, int repeat, const std::string& only,
+           std::vector<double> margins) {
     const Scene input = folded_stack(5, 2000, 10.0 * 2000.0 / 600.0);
     std::vector<Layer> layers = input.layers();
     Layer& middle = layers[2];
@@ -91,15 +95,28 @@ void paper(std::size_t first, std::size_t last, int repeat, const std::string& o
     }
     middle.points = kept;
     const Scene tangled(layers);
+    // By default the box of the earlier runs (the stretch's box grown by 0.3) and the one the
+    // simplification grows around a removal (docs/simplify.md, step 2): by twice the nested
+    // thickness, the thickness of the middle layer and of every layer nested with it (0.1
+    // here). (The driver grows it by half the new chord where that is more, for a chord it
+    // made itself: the naive decimation's chords here are 0.67 long.)
+    if (margins.empty()) {
+        double nest = tangled.layer(2).thickness;
+        for (std::size_t b = 0; b < tangled.size(); ++b)
+            if (b != 2 && tangled.relation(2, b) != Relation::SideBySide)
+                nest += tangled.layer(b).thickness;
+        margins = {0.3, 2.0 * nest};
+    }
     const CheckReport before = check_scene(tangled);
     std::printf(
         "paper 5.2: 5 layers x 2000 vertices, middle layer decimated over vertices %zu-%zu: %zu "
         "crossings; best of %d\n",
         first, last, before.crossing_count, repeat);
-    // free: vertices each run may move (the local run's box covers the decimated stretch, 40%
-    // of the middle layer, and its neighbours there).
-    std::printf("%-28s %10s %10s %8s %10s %12s %8s %8s\n", "run", "global s", "local s", "ratio",
-                "crossings", "free", "rounds", "passes");
+    // margin: how far the local box reaches beyond the stretch's box; free: vertices each run
+    // may move; clean: the local result is collision-free with its gaps (smallest gap /
+    // required after it).
+    std::printf("%-16s %6s %9s %9s %6s %9s %6s %6s %10s %7s %7s\n", "run", "margin", "global s",
+                "local s", "ratio", "crossings", "clean", "gap", "free", "rounds", "passes");
     const bool run_global = only != "local", run_local = only != "global";
     for (const bool converge : {false, true}) {
         UntangleParams params;
@@ -107,13 +124,15 @@ void paper(std::size_t first, std::size_t last, int repeat, const std::string& o
         params.alpha = 0.8;
         params.beta = 0.9;
         params.field.backend = FieldBackend::ExactIndexed;
-        if (!converge) {  // exactly 150 iterations: 5 rounds, one pass, no early stop
+        if (!converge) {  // at most 150 iterations: 5 rounds, one pass, no early stop
             params.max_rounds = 5;
             params.max_passes = 1;
             params.tolerance = 1e-300;
         }
-        double tg = 1e300, tl = 1e300;
-        UntangleReport rg, rl;
+        double tg = 1e300;
+        std::vector<double> tl(margins.size(), 1e300);
+        UntangleReport rg;
+        std::vector<UntangleReport> rl(margins.size());
         for (int k = 0; k < repeat; ++k) {
             if (run_global) {
                 Scene global = tangled;
@@ -121,24 +140,32 @@ void paper(std::size_t first, std::size_t last, int repeat, const std::string& o
                 rg = untangle(global, params);
                 tg = std::min(tg, now() - t);
             }
-            if (run_local) {
+            for (std::size_t m = 0; m < margins.size() && run_local; ++m) {
                 Scene local = tangled;
                 const double t = now();
-                rl = untangle_local(local, box.inflated(0.3), 7, params);
-                tl = std::min(tl, now() - t);
+                rl[m] = untangle_local(local, box.inflated(margins[m]), 7, params);
+                tl[m] = std::min(tl[m], now() - t);
             }
         }
         if (!run_global) tg = 0.0;
-        if (!run_local) tl = 0.0;
-        std::printf("%-28s %10.3f %10.3f %8.1f %5zu/%-4zu %6zu/%-5zu %3d/%-4d %3d/%-4d\n",
-                    converge ? "until converged" : "150 iterations", tg, tl,
-                    tl > 0.0 ? tg / tl : 0.0, rg.crossings_after, rl.crossings_after,
-                    rg.free_vertices, rl.free_vertices, rg.rounds, rl.rounds, rg.passes, rl.passes);
-        std::printf(
-            "  phases of the last run (fields / untangle / check / finish s): global %.4f / %.4f "
-            "/ %.4f / %.4f, local %.4f / %.4f / %.4f / %.4f\n",
-            rg.seconds_fields, rg.seconds_untangle, rg.seconds_check, rg.seconds_finish,
-            rl.seconds_fields, rl.seconds_untangle, rl.seconds_check, rl.seconds_finish);
+        for (std::size_t m = 0; m < margins.size(); ++m) {
+            if (!run_local) tl[m] = 0.0;
+            std::printf(
+                "%-16s %6.3f %9.3f %9.3f %6.1f %4zu/%-4zu %6s %6.3f %5zu/%-4zu %3d/%-3d %3d/%-3d\n",
+                converge ? "until converged" : "150 iterations", margins[m], tg, tl[m],
+                tl[m] > 0.0 ? tg / tl[m] : 0.0, rg.crossings_after, rl[m].crossings_after,
+                !run_local             ? "-"
+                : rl[m].collision_free ? "yes"
+                                       : "NO",
+                rl[m].min_separation_ratio_after, rg.free_vertices, rl[m].free_vertices, rg.rounds,
+                rl[m].rounds, rg.passes, rl[m].passes);
+            std::printf(
+                "  phases of the last run (fields / untangle / check / finish s): global %.4f / "
+                "%.4f / %.4f / %.4f, local %.4f / %.4f / %.4f / %.4f\n",
+                rg.seconds_fields, rg.seconds_untangle, rg.seconds_check, rg.seconds_finish,
+                rl[m].seconds_fields, rl[m].seconds_untangle, rl[m].seconds_check,
+                rl[m].seconds_finish);
+        }
     }
 }
 
@@ -275,6 +302,7 @@ int main(int argc, char** argv) {
     if (what == "paper") {
         int repeat = 3;
         std::string only, stretch;
+        std::vector<double> margins;
         for (int i = 2; i + 1 < argc; i += 2) {
             const std::string key = argv[i], value = argv[i + 1];
             if (key == "--repeat" && std::atoi(value.c_str()) >= 1) {
@@ -283,14 +311,16 @@ int main(int argc, char** argv) {
                 only = value;
             } else if (key == "--stretch" && (value == "long" || value == "short")) {
                 stretch = value;
+            } else if (key == "--margin" && std::atof(value.c_str()) >= 0.0) {
+                margins.push_back(std::atof(value.c_str()));
             } else {
                 std::fprintf(stderr, "strata_bench_simplify: bad paper option %s %s\n", key.c_str(),
                              value.c_str());
                 return 2;
             }
         }
-        if (stretch != "short") paper(400, 1200, repeat, only);
-        if (stretch != "long") paper(400, 480, repeat, only);
+        if (stretch != "short") paper(400, 1200, repeat, only, margins);
+        if (stretch != "long") paper(400, 480, repeat, only, margins);
     } else if (what == "scenes") {
         SceneFilter filter;
         for (int i = 2; i + 1 < argc; i += 2) {
@@ -319,8 +349,7 @@ int main(int argc, char** argv) {
                 filter.decimator = value;
             } else if (key == "--give-up" || key == "--finish") {
                 if (value != "0" && value != "1" && value != "0,1" && value != "1,0") {
-                    std::fprintf(stderr,
-                                 "strata_bench_simplify: %s must be 0, 1 or 0,1 (got %s)\n",
+                    std::fprintf(stderr, "strata_bench_simplify: %s must be 0, 1 or 0,1 (got %s)\n",
                                  key.c_str(), value.c_str());
                     return 2;
                 }
@@ -343,7 +372,7 @@ int main(int argc, char** argv) {
     } else {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper [--repeat N] [--only global|local] "
-                     "[--stretch long|short] | scenes [--min N] [--max N] "
+                     "[--stretch long|short] [--margin M]... | scenes [--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
                      "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
                      "[--give-up 0,1] [--finish 0,1] [--decimator random|visvalingam|max-error] "
