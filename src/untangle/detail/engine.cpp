@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -143,27 +144,34 @@ std::size_t own_contacts(const std::vector<Vec2>& x, bool closed, std::size_t v,
     return count;
 }
 
-// Uniform hash grid of vertices, rebuilt at every projection step: finds the vertices of other
-// layers near an edge, where a sample is needed to see them poke through a long chord.
+// Uniform grid of vertices, rebuilt at every projection step: finds the vertices of other
+// layers near an edge, where a sample is needed to see them poke through a long chord. The
+// vertices sorted by cell (column, then row; in filing order within a cell), each query's
+// column one binary search: no allocation once the buffers have grown.
 class VertexGrid {
   public:
     void build(const Scene& scene, const Box2& region, double cell) {
         cell_ = cell;
-        cells_.clear();
         all_.clear();
         for (std::size_t l = 0; l < scene.size(); ++l) {
             const Layer& layer = scene.layer(l);
             if (!layer.bounds().overlaps(region)) continue;
-            for (std::size_t v = 0; v < layer.points.size(); ++v)
-                if (region.contains(layer.points[v])) {
-                    cells_[key(layer.points[v])].push_back({l, v});
-                    all_.push_back({layer.points[v], l, v});
-                }
+            for (std::size_t v = 0; v < layer.points.size(); ++v) {
+                const Vec2& p = layer.points[v];
+                if (region.contains(p)) all_.push_back({p, l, v, coord(p.x), coord(p.y)});
+            }
         }
+        sorted_.resize(all_.size());
+        for (std::size_t k = 0; k < all_.size(); ++k) sorted_[k] = k;
+        std::sort(sorted_.begin(), sorted_.end(), [this](std::size_t a, std::size_t b) {
+            const Entry &ea = all_[a], &eb = all_[b];
+            return std::tie(ea.column, ea.row, a) < std::tie(eb.column, eb.row, b);
+        });
     }
 
-    // Calls f(layer, vertex) for the vertices in the cells that `box` touches, or, when the
-    // box spans more cells than there are vertices, for every vertex in the box.
+    // Calls f(layer, vertex) for the vertices in the cells that `box` touches (cells column by
+    // column, bottom to top), or, when the box spans more cells than there are vertices, for
+    // every vertex in the box.
     template <class F>
     void query(const Box2& box, F&& f) const {
         const auto x0 = coord(box.min.x), x1 = coord(box.max.x);
@@ -174,29 +182,31 @@ class VertexGrid {
                 if (box.contains(e.point)) f(e.layer, e.vertex);
             return;
         }
-        for (auto ix = x0; ix <= x1; ++ix)
-            for (auto iy = y0; iy <= y1; ++iy) {
-                auto it = cells_.find(pack(ix, iy));
-                if (it == cells_.end()) continue;
-                for (const auto& [layer, vertex] : it->second) f(layer, vertex);
+        for (auto ix = x0; ix <= x1; ++ix) {
+            auto it =
+                std::lower_bound(sorted_.begin(), sorted_.end(), std::make_pair(ix, y0),
+                                 [this](std::size_t k, const std::pair<long long, long long>& c) {
+                                     return std::make_pair(all_[k].column, all_[k].row) < c;
+                                 });
+            for (; it != sorted_.end(); ++it) {
+                const Entry& e = all_[*it];
+                if (e.column != ix || e.row > y1) break;
+                f(e.layer, e.vertex);
             }
+        }
     }
 
   private:
     long long coord(double v) const { return static_cast<long long>(std::floor(v / cell_)); }
-    static std::uint64_t pack(long long ix, long long iy) {
-        return (static_cast<std::uint64_t>(ix) << 32) ^
-               (static_cast<std::uint64_t>(iy) & 0xffffffffULL);
-    }
-    std::uint64_t key(const Vec2& p) const { return pack(coord(p.x), coord(p.y)); }
 
     struct Entry {
         Vec2 point;
         std::size_t layer, vertex;
+        long long column, row;
     };
     double cell_ = 1.0;
-    std::unordered_map<std::uint64_t, std::vector<std::pair<std::size_t, std::size_t>>> cells_;
-    std::vector<Entry> all_;
+    std::vector<Entry> all_;           // in filing order (layer, then vertex)
+    std::vector<std::size_t> sorted_;  // indices into all_, by (column, row, filing order)
 };
 
 // The composed value and gradient of one layer at one point.
@@ -612,11 +622,11 @@ class Pass {
     std::vector<double> edge_wa_, edge_wb_;
     std::vector<double> violation_;  // per vertex and edge task: largest |fhat - f|
     std::vector<std::size_t> vertex_offset_, edge_offset_;
-    std::vector<Relation> relation_;    // n x n, work layers
-    std::vector<double> separation_;    // n x n, max(required, min_separation)
+    std::vector<Relation> relation_;  // n x n, work layers
+    std::vector<double> separation_;  // n x n, max(required, min_separation)
     double slack_ = std::numeric_limits<double>::infinity();  // see slack()
-    std::vector<double> layer_weight_;  // per work layer
-    std::vector<std::size_t> rank_;     // layers each is over: innermost 0
+    std::vector<double> layer_weight_;                        // per work layer
+    std::vector<std::size_t> rank_;                           // layers each is over: innermost 0
     bool is_chain_ = true;
     std::vector<Vec2> sum_, next_, current_;
     std::vector<double> weight_;
