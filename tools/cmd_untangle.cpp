@@ -107,6 +107,7 @@ Run add_untangle_command(CLI::App& app) {
             inferred = infer_input_sides(input);
             params.outside_sides = untangling_outside_sides(input);
             params.input_sides = &inferred;
+            params.open_cut_bends = false;  // inferred sides, in question at a cut bend
         }
         // Judged as untangle() judges: by the outside sides it untangles toward (the input's
         // when none are given), not by a fresh vote on the result.

@@ -79,6 +79,7 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
         settings.keep_simple = keep_simple;
         const bool has_sides = params.input_sides && !params.input_sides->empty();
         check_params.input_sides = has_sides ? params.input_sides : nullptr;
+        settings.open_cut_bends = has_sides && params.open_cut_bends;
         // `check`: the last whole check, if any; `counts`: the last check's counts. The check
         // of the input (the reference of the region checks) runs beside the engine's first
         // steps (the fields, the finishing stage, which do not use it); the first verdict
@@ -424,6 +425,7 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     const UntangleParams global = with_outside_sides(scene, params);
     UntangleParams with_sides = global;
     with_sides.input_sides = &inferred;
+    with_sides.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
     const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
     // By the inferred sides, then by the global order; the second tries (no self-crossing
     // made) only when neither first try is clean, so that a scene one of them cleans costs
@@ -473,6 +475,7 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
         for (std::size_t i = 0; i < others.size(); ++i) {
             UntangleParams p = global;
             p.input_sides = &others[i];
+            p.open_cut_bends = false;
             Scene attempt;
             UntangleReport report;
             if (!clean_try(p, keep_simple, attempt, report) ||

@@ -114,6 +114,16 @@ struct UntangleParams {
     /// decides, as without it. Not owned; must outlive the call. simplify() records its own
     /// input's (leave nullptr).
     const InputSides* input_sides = nullptr;
+    /// With params.input_sides recorded in the original (not inferred from the tangled scene
+    /// itself): where the decimation cut a roll's bend, leaving a sharp hairpin of an open layer
+    /// (the two segments at an interior vertex more than 120 degrees apart) and a vertex of
+    /// another layer near its tip, outside its wedge, whose side asks to be inside it, the
+    /// finishing stage moves the tip past that vertex (the bend opens again) instead of leaving
+    /// the projection to drag the vertex, and its layer, around the tip into the wedge
+    /// (docs/untangle.md, "Cut bends"). Only in scenes with rolled vertices (a side that is not
+    /// the global order's). untangle_inferring_sides() and `strata untangle --infer-sides` turn
+    /// it off: inferred sides can be wrong exactly there. simplify() does not use it.
+    bool open_cut_bends = true;
 };
 
 /// Throws InvalidInput naming the first out-of-range field.

@@ -755,6 +755,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     finish.min_separation = settings.min_separation;
     finish.outside_signs = &settings.outside_signs;
     finish.stop_when_wrong_stays = settings.finish_stop_when_wrong_stays;
+    finish.open_cut_bends = settings.open_cut_bends;
     auto check = [&] {
         const auto begin = Clock::now();
         result.ok = is_ok(work);

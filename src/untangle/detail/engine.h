@@ -99,6 +99,9 @@ struct EngineSettings {
     /// SeparationParams::stop_when_wrong_stays of the finishing stage (0: the sweeps run until
     /// they stall). The driver sets 1 for the jobs that hold a rolled vertex.
     int finish_stop_when_wrong_stays = 0;
+    /// SeparationParams::open_cut_bends of the finishing stage: untangle() sets it from
+    /// UntangleParams::open_cut_bends when sides are given; the driver leaves it off.
+    bool open_cut_bends = false;
 };
 
 /// What run_engine() did.

@@ -311,9 +311,9 @@ class Finisher {
             std::int32_t& slot = slot_[s.layer];
             if (slot < 0) {
                 slot = static_cast<std::int32_t>(nearest_.size());
-                nearest_.push_back({s.layer, i, d, false, 0});
+                nearest_.push_back({s.layer, i, d, false, 0, kNoTip});
             } else if (d < nearest_[static_cast<std::size_t>(slot)].distance) {
-                nearest_[static_cast<std::size_t>(slot)] = {s.layer, i, d, false, 0};
+                nearest_[static_cast<std::size_t>(slot)] = {s.layer, i, d, false, 0, kNoTip};
             }
         }
         for (Nearest& x : nearest_) {
@@ -329,12 +329,39 @@ class Finisher {
             x.wanted = wanted;
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
                          orient2d(q0, q1, p) != wanted;
+            x.tip = kNoTip;
+            if (!x.is_wrong && wanted != 0 && x.distance < tangle_reach_ && opens_cut_bends())
+                x.tip = hairpin_tip(s, p, wanted);
         }
         const std::size_t moves_before = result.moves;
+        for (const Nearest& x : nearest_) {
+            if (x.tip == kNoTip) continue;
+            // Beyond the tip of a hairpin of layer m (a bend the decimation cut), on the wrong
+            // side (SeparationParams::open_cut_bends): the tip moves past the vertex by the aim,
+            // so that the vertex lies in the hairpin's wedge, and that layer's other segments
+            // wait. The projection would drag the vertex around the tip instead, and its layer
+            // with it (issue 19).
+            const std::size_t m = x.layer;
+            const Vec2 p = pts_[l][v], q = pts_[m][x.tip];
+            const double d = glm::distance(p, q);
+            const double aim = aim_[l * n + m];
+            ++wrong_side_;
+            worst_ = std::max(worst_, (aim + d) / aim);
+            if (!apply || !(d > 0.0)) continue;
+            const double wp = inverse_mass_[l][v], wq = inverse_mass_[m][x.tip];
+            if (!(wp + wq > 0.0)) continue;
+            // The vertex moves past the tip only when the tip is fixed.
+            const Vec2 u = (q - p) / d;
+            if (wq > 0.0)
+                try_move(m, x.tip, -(d + aim) * u, result, changed);
+            else
+                try_move(l, v, (d + aim) * u, result, changed);
+        }
         for (std::size_t i = 0; i < found_.size(); ++i) {
             const SegId& s = found_[i];
             const std::size_t m = s.layer;
             const Nearest& near = nearest_[static_cast<std::size_t>(slot_[m])];
+            if (near.tip != kNoTip) continue;                // the hairpin's tip above
             if (near.is_wrong && near.index != i) continue;  // the tangle first
             const double aim = aim_[l * n + m];
             // Nothing moved yet in this call: the distance measured above is the one below.
@@ -376,6 +403,43 @@ class Finisher {
         }
         for (const Nearest& x : nearest_) slot_[x.layer] = -1;
     }
+
+    bool opens_cut_bends() const {
+        return params_.open_cut_bends && !relations_.local_sides.empty();
+    }
+
+    // When the closest point of open layer m's segment s to p is an interior vertex of m where
+    // m turns back on itself (a hairpin: the two segments at it more than 120 degrees apart)
+    // and p lies outside the hairpin's wedge while `wanted` (orient2d sign) asks for inside:
+    // that vertex; else kNoTip.
+    std::size_t hairpin_tip(const SegId& s, const Vec2& p, int wanted) const {
+        const std::size_t m = s.layer, n = layer_size(m);
+        if (closed_[m] || n < 3) return kNoTip;
+        const Vec2 q0 = cells_->start(s), q1 = cells_->end(s);
+        const Vec2 e = q1 - q0;
+        const double along = glm::dot(p - q0, e);
+        std::size_t w;
+        if (along <= 0.0)
+            w = s.index;
+        else if (along >= glm::dot(e, e))
+            w = s.index + 1;
+        else
+            return kNoTip;
+        if (w == 0 || w + 1 >= n) return kNoTip;  // an end of m
+        const Vec2 a = pts_[m][w - 1], c = pts_[m][w], b = pts_[m][w + 1];
+        const Vec2 in = c - a, out = b - c;
+        const double li = glm::length(in), lo = glm::length(out);
+        if (!(li > 0.0 && lo > 0.0) || glm::dot(in, out) > -0.5 * li * lo) return kNoTip;
+        const int turn = orient2d(a, c, b);
+        if (turn == 0) return kNoTip;
+        // The wedge is on the side of the turn: inside it, p is on that side of both segments.
+        const bool in_wedge = orient2d(a, c, p) == turn && orient2d(c, b, p) == turn;
+        if (in_wedge) return kNoTip;
+        // corner_side()'s rule: outside the wedge, p counts as on the side away from the turn,
+        // which is the wrong one when the wedge's side (turn) is wanted.
+        return wanted == turn ? w : kNoTip;
+    }
+    static constexpr std::size_t kNoTip = static_cast<std::size_t>(-1);
 
     // The foot of p on segment (q0, q1) lies strictly inside it.
     static bool interior(const Vec2& p, const Vec2& q0, const Vec2& q1) {
@@ -573,6 +637,7 @@ class Finisher {
         double distance;
         bool is_wrong;
         int wanted;  // the side the vertex must be on (orient2d sign), 0: any
+        std::size_t tip = static_cast<std::size_t>(-1);  // see hairpin_tip()
     };
     std::vector<Nearest> nearest_;
     std::vector<std::int32_t> slot_;  // per work layer: its entry in nearest_, -1: none

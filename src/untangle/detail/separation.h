@@ -48,6 +48,14 @@ struct SeparationParams {
     /// Outside side of each work layer (+1: on the right of its direction of travel), see
     /// outside_side(); it says on which side of another layer a vertex belongs.
     const std::vector<int>* outside_signs = nullptr;
+    /// A vertex whose closest point on an open layer m is a hairpin's tip (an interior vertex
+    /// of m where its two segments are more than 120 degrees apart: a bend the decimation cut
+    /// to one vertex) and that lies outside the hairpin's wedge, within the tangle reach, while
+    /// its side of m asks for the inside: the tip moves past the vertex by the aim (the bend
+    /// opens around it), and the vertex stays (it moves onto the tip's far side only when the
+    /// tip is fixed). Only with RelationSource::local_sides (a scene with rolled vertices);
+    /// sides recorded in an original (UntangleParams::open_cut_bends).
+    bool open_cut_bends = false;
 };
 
 /// What finish_separations() did.
