@@ -196,6 +196,52 @@ std::vector<Vec2> tangents_along(const Layer& layer, std::size_t count) {
     return out;
 }
 
+// The vertex centroid of closed `layer` when it lies inside it (a body, not a band).
+std::optional<Vec2> body_centre(const Layer& layer) {
+    if (layer.points.empty()) return std::nullopt;
+    Vec2 centre(0.0);
+    for (const Vec2& p : layer.points) centre += p;
+    centre /= static_cast<double>(layer.points.size());
+    bool inside = false;
+    for (std::size_t k = 0, m = layer.points.size(); k < m; ++k) {
+        const Vec2 u = layer.points[k], w = layer.points[(k + 1) % m];
+        if ((u.y > centre.y) != (w.y > centre.y) &&
+            centre.x < u.x + (centre.y - u.y) / (w.y - u.y) * (w.x - u.x))
+            inside = !inside;
+    }
+    if (!inside) return std::nullopt;
+    return centre;
+}
+
+// The largest closed layer (bounding-box diagonal) with a body_centre() directly under layer
+// `b`; none if there is none.
+std::optional<std::size_t> largest_body_under(const Scene& scene, std::size_t b) {
+    std::optional<std::size_t> best;
+    double best_size = -1.0;
+    for (std::size_t a : scene.inner_of(b)) {
+        const Layer& inner = scene.layer(a);
+        if (!inner.closed || !body_centre(inner)) continue;
+        const Vec2 size = inner.bounds().size();
+        const double d = std::hypot(size.x, size.y);
+        if (d > best_size) {
+            best_size = d;
+            best = a;
+        }
+    }
+    return best;
+}
+
+// The angle (radians) open `layer` turns through seen from `centre`: the sum over its segments
+// of the signed angle between their ends, counter-clockwise positive.
+double swept_angle(const Layer& layer, const Vec2& centre) {
+    double swept = 0.0;
+    for (std::size_t k = 0; k + 1 < layer.points.size(); ++k) {
+        const Vec2 u = layer.points[k] - centre, w = layer.points[k + 1] - centre;
+        swept += std::atan2(u.x * w.y - u.y * w.x, glm::dot(u, w));
+    }
+    return swept;
+}
+
 }  // namespace
 
 std::vector<int> untangling_outside_sides(const Scene& scene) {
@@ -227,28 +273,19 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
     // length, of the sine between its segments and the direction from the closed layer's
     // vertex centroid beyond kAround): outside away from that centroid, whatever the vote.
     constexpr double kAround = 0.8;
+    std::vector<char> around(n, 0);  // decided by the rule above
     for (std::size_t b = 0; b < n; ++b) {
         const Layer& layer = scene.layer(b);
         if (layer.closed) continue;
         for (std::size_t a : scene.inner_of(b)) {
             const Layer& inner = scene.layer(a);
             if (!inner.closed) continue;
-            Vec2 centre(0.0);
-            for (const Vec2& p : inner.points) centre += p;
-            centre /= static_cast<double>(inner.points.size());
-            // Only around a body: the centre inside the closed layer (not a band).
-            bool inside = false;
-            for (std::size_t k = 0, m = inner.points.size(); k < m; ++k) {
-                const Vec2 u = inner.points[k], w = inner.points[(k + 1) % m];
-                if ((u.y > centre.y) != (w.y > centre.y) &&
-                    centre.x < u.x + (centre.y - u.y) / (w.y - u.y) * (w.x - u.x))
-                    inside = !inside;
-            }
-            if (!inside) continue;
+            const std::optional<Vec2> centre = body_centre(inner);
+            if (!centre) continue;
             double turn = 0.0, total = 0.0;
             for (std::size_t k = 0; k + 1 < layer.points.size(); ++k) {
                 const Vec2 d = layer.points[k + 1] - layer.points[k];
-                const Vec2 r = 0.5 * (layer.points[k] + layer.points[k + 1]) - centre;
+                const Vec2 r = 0.5 * (layer.points[k] + layer.points[k + 1]) - *centre;
                 const double rl = glm::length(r);
                 if (!(rl > 0.0)) continue;
                 turn += (r.x * d.y - r.y * d.x) / rl;
@@ -257,8 +294,24 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
             if (!(total > 0.0) || std::abs(turn / total) < kAround) continue;
             // Counter-clockwise around the centre: the outside is on the right (+1).
             sides[b] = turn > 0.0 ? 1 : -1;
+            around[b] = 1;
             break;
         }
+    }
+    // An open layer directly over a body that the rule above left to its vote (the largest
+    // closed layer directly under it, bounding-box diagonals, whose vertex centroid lies
+    // inside it), which it sweeps around by at least kSweep (the angle its vertices turn
+    // through seen from that centroid): outside away from the body. For a layer that runs
+    // back in part (a fold or a roll at its end, where the mean sine fails), whose vote
+    // counts the neighbours' vertices a tangle scattered. The largest: a small loop in a fold
+    // of the layer (a collar's cord) is swept around the other way.
+    constexpr double kSweep = 2.0 * 3.14159265358979323846 / 3.0;
+    for (std::size_t b = 0; b < n; ++b) {
+        if (scene.layer(b).closed || around[b]) continue;
+        const std::optional<std::size_t> body = largest_body_under(scene, b);
+        if (!body) continue;
+        const double swept = swept_angle(scene.layer(b), *body_centre(scene.layer(*body)));
+        if (std::abs(swept) >= kSweep) sides[b] = swept > 0.0 ? 1 : -1;
     }
     // Directly related open layers that run along each other (the mean cosine of their
     // tangents at the same fraction of their lengths beyond +-kParallel): the same outside

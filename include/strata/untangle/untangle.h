@@ -174,7 +174,10 @@ struct UntangleReport {
 /// layer directly over a closed one whose vertex centroid lies inside it, and that runs around
 /// that centroid (the mean over its segments, weighted by length, of the sine between the
 /// segment and the direction from the centroid beyond 0.8 either way), faces away from it (+1
-/// counter-clockwise), whatever its vote (a tangled body's vertices can outvote it). Two directly
+/// counter-clockwise), whatever its vote (a tangled body's vertices can outvote it). One that
+/// runs back in part (a fold at its end: the mean sine fails) faces away from the largest such
+/// closed layer directly under it (bounding-box diagonal) when it sweeps around its centroid by
+/// at least 120 degrees (the signed angles its segments subtend from there). Two directly
 /// related open layers that run along each other (the mean cosine of their tangents at 64
 /// evenly spaced fractions of their lengths beyond 0.8 either way) must have the same outside
 /// side when they travel the same way and opposite ones otherwise. Where the votes of a chain
