@@ -172,15 +172,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         u.finish_separations = in.byte() % 4 != 0;
         const strata::Scene tangled = scene;
         strata::UntangleReport ur;
+        strata::InputSides inferred;  // the sides it kept, when it kept inferred ones
         try {
-            ur = strata::untangle_inferring_sides(scene, u);  // as the CLI
+            ur = strata::untangle_inferring_sides(scene, u, {}, &inferred);  // as the CLI
         } catch (const strata::InvalidInput& e) {
             return known_refusal(e);
         }
         // Judged as it judged itself: the global order, or the sides inferred per region of
         // the tangled scene where it kept those.
-        const strata::InputSides inferred =
-            ur.inferred_sides ? strata::infer_input_sides(tangled) : strata::InputSides{};
         const strata::CheckReport after =
             ur.inferred_sides ? exact_check(scene, strata::outside_sides(tangled),
                                             u.separation_tolerance, &inferred)

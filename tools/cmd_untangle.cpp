@@ -104,8 +104,8 @@ Run add_untangle_command(CLI::App& app) {
             params.outside_sides = reference->outside_sides;
             params.input_sides = &reference->sides;  // untangling keeps the vertex indices
         } else if (opt->infer_sides) {
-            inferred = infer_input_sides(input);
             params.outside_sides = untangling_outside_sides(input);
+            inferred = infer_input_sides(input, {}, params.outside_sides);
             params.input_sides = &inferred;
             params.open_cut_bends = false;  // inferred sides, in question at a cut bend
         }

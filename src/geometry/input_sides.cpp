@@ -142,15 +142,19 @@ double diagonal(const Layer& layer) {
 
 }  // namespace
 
-InputSides InputSides::by_region(const Scene& scene) const {
-    return from_codes(scene, region_codes(scene, nullptr));
+InputSides InputSides::by_region(const Scene& scene, const std::vector<int>& outside_sides) const {
+    return from_codes(scene, region_codes(scene, outside_sides, nullptr));
 }
 
 std::vector<std::vector<signed char>> InputSides::region_codes(
-    const Scene& scene, std::vector<Alternative>* split) const {
+    const Scene& scene, const std::vector<int>& outside_sides,
+    std::vector<Alternative>* split) const {
     if (n_ != scene.size())
         throw InvalidInput("input sides: by_region() got a scene of " +
                            std::to_string(scene.size()) + " layers for " + std::to_string(n_));
+    if (!outside_sides.empty() && outside_sides.size() != n_)
+        throw InvalidInput("input sides: by_region() got " + std::to_string(outside_sides.size()) +
+                           " outside sides for " + std::to_string(n_) + " layers");
     std::vector<std::vector<signed char>> codes(n_ * n_);
     for (std::size_t a = 0; a < n_; ++a)
         for (std::size_t b = 0; b < n_; ++b) {
@@ -226,13 +230,32 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     for (const int either : {1, -1})
                         add(one, [&](std::size_t) { return static_cast<signed char>(either); });
             }
+            // An open layer all of whose vertices with a side are read on the other side than
+            // the global order's: not a roll (a roll is part of a layer, the rest on the global
+            // order's side) but the two layers' order read inside out (a tangle that put most
+            // of a layer across its neighbour). The global order's side.
+            if (!outside_sides.empty() && !layer.closed) {
+                const int wanted = global_side(scene.relation(a, b), outside_sides[b]);
+                bool swapped = wanted != 0;
+                bool sided = false;
+                for (const signed char c : s) {
+                    if (c != 1 && c != -1) continue;
+                    sided = true;
+                    swapped = swapped && c != wanted;
+                }
+                if (sided && swapped)
+                    for (signed char& c : s)
+                        if (c == 1 || c == -1) c = static_cast<signed char>(wanted);
+            }
         }
     return codes;
 }
 
-std::vector<InputSides> InputSides::region_alternatives(const Scene& scene) const {
+std::vector<InputSides> InputSides::region_alternatives(
+    const Scene& scene, const std::vector<int>& outside_sides) const {
     std::vector<Alternative> alternatives;
-    const std::vector<std::vector<signed char>> codes = region_codes(scene, &alternatives);
+    const std::vector<std::vector<signed char>> codes =
+        region_codes(scene, outside_sides, &alternatives);
     std::stable_sort(alternatives.begin(), alternatives.end(),
                      [](const Alternative& x, const Alternative& y) { return x.score > y.score; });
     std::vector<InputSides> out;
@@ -247,8 +270,9 @@ std::vector<InputSides> InputSides::region_alternatives(const Scene& scene) cons
     return out;
 }
 
-InputSides infer_input_sides(const Scene& scene, const InputSideParams& params) {
-    return record_input_sides(scene, params).by_region(scene);
+InputSides infer_input_sides(const Scene& scene, const InputSideParams& params,
+                             const std::vector<int>& outside_sides) {
+    return record_input_sides(scene, params).by_region(scene, outside_sides);
 }
 
 std::size_t InputSides::rolled_count(const Scene& scene,

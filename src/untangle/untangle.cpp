@@ -425,7 +425,8 @@ namespace {
 // Whether `scene` has regions on a rolled side by its inferred sides (infer_input_sides()):
 // where it has, which side a region belongs on is in question.
 bool has_rolled_regions(const Scene& scene) {
-    return infer_input_sides(scene).rolled_count(scene, untangling_outside_sides(scene)) > 0;
+    const std::vector<int> outside = untangling_outside_sides(scene);
+    return infer_input_sides(scene, {}, outside).rolled_count(scene, outside) > 0;
 }
 
 // When the tries with params fail, they run again with long rounds (UntangleParams::
@@ -474,8 +475,8 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
     const InputSides recorded = record_input_sides(scene);
-    InputSides inferred = recorded.by_region(scene);
     const UntangleParams global = with_outside_sides(scene, params);
+    InputSides inferred = recorded.by_region(scene, global.outside_sides);
     UntangleParams with_sides = global;
     with_sides.input_sides = &inferred;
     with_sides.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
@@ -519,7 +520,8 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     // first), each tried once, then once more without self-crossings made (as above); of the
     // clean results of the first round that has one, the one that moves the input least.
     std::vector<InputSides> others;
-    if (params.other_readings > 0) others = recorded.region_alternatives(scene);
+    if (params.other_readings > 0)
+        others = recorded.region_alternatives(scene, global.outside_sides);
     if (others.size() > params.other_readings) others.resize(params.other_readings);
     for (bool keep_simple : {false, true}) {
         std::size_t best = others.size();

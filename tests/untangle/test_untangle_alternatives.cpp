@@ -221,3 +221,47 @@ TEST_CASE("untangling_outside_sides: a collar folded at its end faces away from 
     }
     CHECK(outvoted > 0);  // what the test is about: some decimation turns the vote
 }
+
+TEST_CASE("by_region with outside sides: a layer read wholly over the one above it is not a roll",
+          "[untangle][sides]") {
+    // Two open layers, `under` below `over`. Tangled, 7 of under's 9 inner vertices went across
+    // over: one region, whose majority reads the whole of under as rolled over over (their
+    // order inside out, which holds once untangled: a silent wrong reading). A roll is part of
+    // a layer; with the outside sides given, a layer wholly on the rolled side takes the global
+    // order's side.
+    auto scene = [](bool tangled) {
+        Layer under, over;
+        under.name = "under";
+        over.name = "over";
+        for (int k = 0; k <= 10; ++k) {
+            const bool across = tangled && k > 0 && k < 10 && k != 3 && k != 7;
+            under.points.push_back(Vec2(k, across ? 1.3 : 0.0));
+            over.points.push_back(Vec2(k, 1.0));
+        }
+        return Scene({under, over});
+    };
+    const Scene input = scene(false);
+    const Scene tangled = scene(true);
+    REQUIRE(check_scene(tangled).crossing_count > 0);
+    const std::vector<int> outside = outside_sides(input);
+    const InputSides recorded = record_input_sides(tangled);
+    CHECK(recorded.by_region(tangled).rolled_count(tangled, outside) > 0);  // without the rule
+    CHECK(recorded.by_region(tangled, outside).rolled_count(tangled, outside) == 0);
+    // Untangled without the original's sides (its outside sides given: in a scene this
+    // symmetric the tangle turns their votes too), under ends up under over again.
+    Scene out = tangled;
+    UntangleParams params;
+    params.outside_sides = outside;
+    CHECK(untangle_inferring_sides(out, params).collision_free);
+    CheckParams judged;
+    judged.outside_sides = outside;
+    CHECK(check_scene(out, judged).nesting_violation_count == 0);
+    // A real roll keeps its side: the rolled family's roll, read from the untangled input.
+    const Scene rolled = make_scene(SceneFamily::Rolled);
+    const std::vector<int> rolled_outside = outside_sides(rolled);
+    const InputSides rolled_sides = record_input_sides(rolled);
+    const std::size_t roll = rolled_sides.by_region(rolled).rolled_count(rolled, rolled_outside);
+    CHECK(roll > 0);
+    CHECK(rolled_sides.by_region(rolled, rolled_outside).rolled_count(rolled, rolled_outside) ==
+          roll);
+}

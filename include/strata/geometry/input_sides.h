@@ -74,7 +74,14 @@ class InputSides {
     /// except that a closed layer whose vertices all form one region and disagree (a loop all
     /// within reach of b, e.g. a cord in a fold of b) takes the side of its vertex centroid
     /// (its bulk), when that side is defined (the centroid's closest point on b not an end).
-    InputSides by_region(const Scene& scene) const;
+    ///
+    /// With `outside_sides` (outside_side() per layer of `scene`, e.g.
+    /// untangling_outside_sides()), an open layer all of whose vertices with a side of b come
+    /// out on the other side than the global order's takes the global order's side of b: a
+    /// roll is part of a layer, and a whole layer read over the one above it is their order
+    /// read inside out. Empty: no such rule. @throws InvalidInput a scene or `outside_sides`
+    /// of another layer count.
+    InputSides by_region(const Scene& scene, const std::vector<int>& outside_sides = {}) const;
     /// Other readings of the sides by_region(scene) infers, for when the untangling by those
     /// is not clean: one per region whose vertices' recorded sides disagree, each the sides of
     /// by_region() with that one region read otherwise. A region of an open layer whose
@@ -83,7 +90,9 @@ class InputSides {
     /// a tangle) is split in two there; any other takes the side by_region() did not give it
     /// (both sides on a tie). Ordered by the share of the region's vertices the reading agrees
     /// with, less the majority's share, highest first (a split first, then the closest votes).
-    std::vector<InputSides> region_alternatives(const Scene& scene) const;
+    /// `outside_sides`: as by_region()'s.
+    std::vector<InputSides> region_alternatives(const Scene& scene,
+                                                const std::vector<int>& outside_sides = {}) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
     /// outside_side() per layer of `scene`, the scene these sides are for): the rolled or
     /// folded-over vertices, once per other layer. Finds the side of every vertex.
@@ -109,6 +118,7 @@ class InputSides {
     };
     /// The codes of by_region(scene); with `split`, the other readings of its regions too.
     std::vector<std::vector<signed char>> region_codes(const Scene& scene,
+                                                       const std::vector<int>& outside_sides,
                                                        std::vector<Alternative>* split) const;
     friend InputSides record_input_sides(const Scene&, const InputSideParams&);
 
@@ -129,10 +139,11 @@ class InputSides {
 InputSides record_input_sides(const Scene& scene, const InputSideParams& params = {});
 
 /// @brief Sides inferred from a tangled scene alone (no original at hand):
-/// record_input_sides(scene, params).by_region(scene). A rolled part, a whole region on the
-/// other side of an open layer, keeps that side; a vertex that a tangle put on the wrong side
-/// takes its region's. @throws InvalidInput bad params.
-InputSides infer_input_sides(const Scene& scene, const InputSideParams& params = {});
+/// record_input_sides(scene, params).by_region(scene, outside_sides). A rolled part, a whole
+/// region on the other side of an open layer, keeps that side; a vertex that a tangle put on
+/// the wrong side takes its region's. @throws InvalidInput bad params.
+InputSides infer_input_sides(const Scene& scene, const InputSideParams& params = {},
+                             const std::vector<int>& outside_sides = {});
 
 /// The side rule of check_scene() where the closest point of a polyline to `v` is the corner
 /// `w` between its segments (u, w) and (w, x): +1 right of the direction of travel, -1 left.
