@@ -2,6 +2,7 @@
 
 #include "strata/core/error.h"
 #include "strata/core/format.h"
+#include "strata/geometry/checks.h"
 #include "strata/geometry/predicates.h"
 
 #include <glm/geometric.hpp>
@@ -134,6 +135,38 @@ signed char centroid_side(const Layer& layer, const Layer& other) {
     return static_cast<signed char>(side);
 }
 
+// The side of open layer `other` that closed `layer`'s vertices lie on by every part of
+// `other` near them, not only the nearest: the sum over the vertices of `layer` and the
+// segments of `other` closer than `near` whose closest point to the vertex is inside the
+// segment, of the side of the segment the vertex is on (+1 right of its direction of travel);
+// 0 on a tie, and 0 unless the segments counted include two that run opposite ways (a fold
+// of `other` around the loop; along one arm, the centroid rule of by_region() decides). Around
+// a fold both arms count: a loop inside it is on the same side of both (the fold's inside),
+// where the nearest arm alone says what a chord of a decimated fold cut across it says.
+signed char arms_side(const Layer& layer, const Layer& other, double near) {
+    long vote = 0;
+    bool fold = false;
+    Vec2 first(0.0);
+    const std::vector<Vec2>& q = other.points;
+    for (const Vec2& v : layer.points)
+        for (std::size_t j = 0; j + 1 < q.size(); ++j) {
+            const Vec2 d = q[j + 1] - q[j];
+            const double len2 = glm::dot(d, d);
+            if (!(len2 > 0.0)) continue;
+            const double t = glm::dot(v - q[j], d) / len2;
+            if (t < 0.0 || t > 1.0) continue;
+            const Vec2 c = q[j] + t * d;
+            if (glm::dot(v - c, v - c) > near * near) continue;
+            vote += segment_side(q[j], q[j + 1], v);
+            if (first == Vec2(0.0))
+                first = d;
+            else if (glm::dot(first, d) < 0.0)
+                fold = true;
+        }
+    if (!fold) return 0;
+    return static_cast<signed char>(vote > 0 ? 1 : (vote < 0 ? -1 : 0));
+}
+
 // The diagonal of `layer`'s bounding box.
 double diagonal(const Layer& layer) {
     const Vec2 size = layer.bounds().size();
@@ -156,6 +189,7 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
         throw InvalidInput("input sides: by_region() got " + std::to_string(outside_sides.size()) +
                            " outside sides for " + std::to_string(n_) + " layers");
     std::vector<std::vector<signed char>> codes(n_ * n_);
+    double near = -1.0;  // automatic_near_distance(scene), when first needed
     for (std::size_t a = 0; a < n_; ++a)
         for (std::size_t b = 0; b < n_; ++b) {
             const Layer& layer = scene.layer(a);
@@ -229,6 +263,17 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                 else
                     for (const int either : {1, -1})
                         add(one, [&](std::size_t) { return static_cast<signed char>(either); });
+            }
+            // A closed loop at most half the open layer's size (as above) with vertices within
+            // reach: all of it (but vertices around b's end) on the side its vertices are on by
+            // every arm of the layer near them (arms_side()), when that is not a tie. A loop
+            // lies on one side of a layer: a vertex out of reach too.
+            const bool small = layer.closed && diagonal(layer) <= 0.5 * diagonal(scene.layer(b));
+            if (small && !scene.layer(b).closed) {
+                if (near < 0.0) near = automatic_near_distance(scene);
+                if (const signed char arms = arms_side(layer, scene.layer(b), near); arms != 0)
+                    for (signed char& c : s)
+                        if (c != kBeyondEnd) c = arms;
             }
             // An open layer all of whose vertices with a side are read on the other side than
             // the global order's: not a roll (a roll is part of a layer, the rest on the global

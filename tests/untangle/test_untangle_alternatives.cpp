@@ -265,3 +265,51 @@ TEST_CASE("by_region with outside sides: a layer read wholly over the one above 
     CHECK(rolled_sides.by_region(rolled, rolled_outside).rolled_count(rolled, rolled_outside) ==
           roll);
 }
+
+TEST_CASE("by_region: a small loop in a fold takes the side both arms near it say",
+          "[untangle][sides]") {
+    // The collar folded around its cord, 95% removed at random: the decimated fold's chords cut
+    // across the cord, and the cord's vertices nearest to a chord lie outside it (the
+    // original has the whole cord on the collar's outside face, in the fold). Counting the
+    // side of every part of the collar near each vertex (both arms of the fold) reads the cord
+    // as the original has it more often than its vertices' nearest sides do.
+    const Scene input = make_scene(SceneFamily::CollarWrap);
+    const std::size_t cord = 1, collar = 2;
+    REQUIRE(input.layer(cord).closed);
+    const InputSides original = record_input_sides(input);
+    const int side = original.side(cord, 0, collar);
+    REQUIRE(side != 0);
+    std::size_t right = 0, right_nearest = 0;
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+        const Scene tangled = naive_decimation(input, 0.95, seed);
+        const InputSides recorded = record_input_sides(tangled);
+        const InputSides read = recorded.by_region(tangled, untangling_outside_sides(tangled));
+        long nearest = 0;
+        bool all = true;
+        for (std::size_t k = 0; k < tangled.layer(cord).points.size(); ++k) {
+            nearest += recorded.side(cord, k, collar);
+            all = all && (read.side(cord, k, collar) == side || read.beyond_end(cord, k, collar));
+        }
+        if (all) ++right;
+        if (nearest * side > 0) ++right_nearest;
+    }
+    INFO("read right: " << right << " of 20, by the nearest sides' majority: " << right_nearest);
+    CHECK(right > right_nearest);
+    CHECK(right >= 18);  // the chords' cut leaves a few decimations unreadable
+}
+
+TEST_CASE("by_region: a loop along one arm of an open layer is left to the centroid rule",
+          "[untangle][sides]") {
+    // No fold: every segment of b near the loop runs the same way, and the side of both arms
+    // does not apply (the loop of "a closed loop within reach takes the side of its bulk").
+    Layer a;
+    a.name = "a";
+    a.closed = true;
+    a.points = {{3.0, -0.02}, {5.0, -0.02}, {7.0, -0.02}, {7.0, 1.0}, {3.0, 1.0}};
+    Layer b;
+    b.name = "b";
+    b.points = {{0.0, 0.0}, {2.0, 0.0}, {4.0, 0.0}, {6.0, 0.0}, {8.0, 0.0}, {10.0, 0.0}};
+    const Scene scene({a, b});
+    CHECK(sides_of(record_input_sides(scene).by_region(scene, outside_sides(scene)), scene, 0, 1) ==
+          "-----");
+}

@@ -74,6 +74,11 @@ class InputSides {
     /// except that a closed layer whose vertices all form one region and disagree (a loop all
     /// within reach of b, e.g. a cord in a fold of b) takes the side of its vertex centroid
     /// (its bulk), when that side is defined (the centroid's closest point on b not an end).
+    /// A closed layer at most half b's size (bounding-box diagonals) in a fold of b takes, all
+    /// of it but its vertices around b's end, the side its vertices are on by every segment of
+    /// b nearer than the automatic near distance whose closest point is inside the segment
+    /// (both arms of the fold, not only the nearest), when those segments include two that run
+    /// opposite ways (a fold) and the count is not a tie.
     ///
     /// With `outside_sides` (outside_side() per layer of `scene`, e.g.
     /// untangling_outside_sides()), an open layer all of whose vertices with a side of b come
