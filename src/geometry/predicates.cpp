@@ -24,15 +24,78 @@ int sign_of(const Rational& value) {
     return value > 0 ? 1 : (value < 0 ? -1 : 0);
 }
 
-}  // namespace
-
-int detail::orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c) {
-    // Every double is a dyadic rational: the conversions and the arithmetic are exact.
+// orient2d() by exact rational arithmetic: every double is a dyadic rational, so the
+// conversions and the arithmetic are exact (any finite coordinates).
+int orient2d_rational(const Vec2& a, const Vec2& b, const Vec2& c) {
     const Rational acx = Rational(a.x) - Rational(c.x);
     const Rational bcx = Rational(b.x) - Rational(c.x);
     const Rational acy = Rational(a.y) - Rational(c.y);
     const Rational bcy = Rational(b.y) - Rational(c.y);
     return sign_of(acx * bcy - acy * bcx);
+}
+
+// x = a + b exactly as hi + lo (Knuth's TwoSum; exact unless it overflows).
+void two_sum(double a, double b, double& hi, double& lo) {
+    hi = a + b;
+    const double bv = hi - a;
+    lo = (a - (hi - bv)) + (b - bv);
+}
+
+// e (n components, nonoverlapping, increasing magnitude, no zeros) + b, the same way
+// (Shewchuk's GROW-EXPANSION with zero elimination); returns the new length.
+std::size_t grow_expansion(double* e, std::size_t n, double b) {
+    std::size_t m = 0;
+    double q = b;
+    for (std::size_t i = 0; i < n; ++i) {
+        double hi = 0.0, lo = 0.0;
+        two_sum(q, e[i], hi, lo);
+        if (lo != 0.0) e[m++] = lo;
+        q = hi;
+    }
+    if (q != 0.0) e[m++] = q;
+    return m;
+}
+
+// Every coordinate 0 or within [2^-200, 2^200] in magnitude: then every difference, product
+// and product error of orient2d_expansion() is a multiple of 2^-504 and below 2^403, far from
+// underflow and overflow, and its TwoSum/FMA steps are exact.
+bool in_expansion_range(const Vec2& a, const Vec2& b, const Vec2& c) {
+    for (const double v : {a.x, a.y, b.x, b.y, c.x, c.y}) {
+        const double m = std::fabs(v);
+        if (m != 0.0 && !(m >= 0x1p-200 && m <= 0x1p200)) return false;  // NaN: false
+    }
+    return true;
+}
+
+// Sign of (a - c) x (b - c), exact by floating-point expansions (the differences by TwoSum,
+// their products by FMA, the 16 terms summed without error): the same sign as the rational
+// arithmetic below, about two orders of magnitude faster.
+int orient2d_expansion(const Vec2& a, const Vec2& b, const Vec2& c) {
+    double ax[2], bx[2], ay[2], by[2];  // hi, lo
+    two_sum(a.x, -c.x, ax[0], ax[1]);
+    two_sum(b.x, -c.x, bx[0], bx[1]);
+    two_sum(a.y, -c.y, ay[0], ay[1]);
+    two_sum(b.y, -c.y, by[0], by[1]);
+    double e[16];
+    std::size_t n = 0;
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) {
+            const double p = ax[i] * by[j];  // + (ax by)
+            n = grow_expansion(e, n, p);
+            n = grow_expansion(e, n, std::fma(ax[i], by[j], -p));
+            const double q = ay[i] * bx[j];  // - (ay bx)
+            n = grow_expansion(e, n, -q);
+            n = grow_expansion(e, n, -std::fma(ay[i], bx[j], -q));
+        }
+    // Nonoverlapping, increasing magnitude: the last component carries the sign.
+    return n == 0 ? 0 : (e[n - 1] > 0.0 ? 1 : -1);
+}
+
+}  // namespace
+
+int detail::orient2d_exact(const Vec2& a, const Vec2& b, const Vec2& c) {
+    if (in_expansion_range(a, b, c)) return orient2d_expansion(a, b, c);
+    return orient2d_rational(a, b, c);
 }
 
 SegmentContact detail::segment_contact_in_boxes(const Vec2& p0, const Vec2& p1, const Vec2& q0,

@@ -2,6 +2,15 @@
 
 #include <catch2/catch.hpp>
 
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+#include <boost/multiprecision/cpp_int.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -24,7 +33,41 @@ double next_down(double x) {
     return std::nextafter(x, -std::numeric_limits<double>::infinity());
 }
 
+// The sign of (a - c) x (b - c) in exact rationals, as a reference.
+int rational_orient(const Vec2& a, const Vec2& b, const Vec2& c) {
+    using R = boost::multiprecision::cpp_rational;
+    const R d = (R(a.x) - R(c.x)) * (R(b.y) - R(c.y)) - (R(a.y) - R(c.y)) * (R(b.x) - R(c.x));
+    return d > 0 ? 1 : (d < 0 ? -1 : 0);
+}
+
 }  // namespace
+
+TEST_CASE("orient2d's exact stage agrees with rational arithmetic near degeneracy",
+          "[predicates]") {
+    // Points on a line, a few ulps off it, at scales from 1e-70 to 1e70 (the floating-point
+    // expansions and, outside their range, the rationals decide them): the filter cannot.
+    std::mt19937_64 rng(19);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::uniform_int_distribution<int> ulps(-3, 3), exponent(-70, 70);
+    int zeros = 0, signs = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const double scale = std::pow(10.0, exponent(rng));
+        const Vec2 a(unit(rng) * scale, unit(rng) * scale);
+        const Vec2 d(unit(rng) * scale, unit(rng) * scale);
+        const double t = unit(rng) * 3.0;
+        Vec2 b = a + d, c = a + t * d;
+        for (int k = ulps(rng); k != 0; k += k > 0 ? -1 : 1)
+            c.y = k > 0 ? next_up(c.y) : next_down(c.y);
+        if (i % 5 == 0) c = a + 0.5 * (b - a);  // often exactly on the line (dyadic midpoint)
+        const int want = rational_orient(a, b, c);
+        REQUIRE(detail::orient2d_exact(a, b, c) == want);
+        REQUIRE(detail::orient2d_exact(b, c, a) == want);
+        REQUIRE(orient2d(c, b, a) == -want);
+        (want == 0 ? zeros : signs) += 1;
+    }
+    CHECK(zeros > 500);  // both outcomes were exercised
+    CHECK(signs > 1000);
+}
 
 TEST_CASE("orient2d gives the sign of the triangle area", "[predicates]") {
     CHECK(orient2d({0, 0}, {1, 0}, {0, 1}) == 1);
