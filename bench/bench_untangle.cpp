@@ -18,7 +18,7 @@
 // moved vertices, the largest Hausdorff distance of a layer to its un-decimated input.
 // Usage: strata_bench_untangle [--family NAME] [--tangle naive90|naive95|dp]
 //                              [--backend indexed|grid] [--points N] [--timing] [--write DIR]
-//                              [--sides | --global-order] [--unrolled]
+//                              [--sides | --global-order] [--unrolled] [--gap G]
 // --write DIR: every case's generated input (NAME.input.json), tangled input
 // (NAME.tangled.json) and result (NAME.json, and
 // NAME.svg with the tangled input drawn faintly under it), DIR existing.
@@ -31,6 +31,8 @@
 // its sides of the open layers are given to untangle() (UntangleParams::input_sides,
 // outside_sides). Real slices are untangled as without it (their input is the tangle).
 // --global-order: untangle() by the global order alone (`strata untangle --global-order`).
+// --gap G: FamilyParams::gap (segment lengths, default 2) of every family's scene (not the
+// stack's fixed wider and narrower cases), e.g. to sweep `strata simplify` over gaps.
 // --unrolled: the rolled families' counterparts that keep the global order
 // (FamilyParams::unrolled; named NAME_unrolled), e.g. to time `strata simplify` on the same
 // scene without its roll.
@@ -120,12 +122,14 @@ struct Case {
 };
 
 bool unrolled = false;  // --unrolled
+double family_gap = 2.0;  // --gap (FamilyParams::gap, the families of all_scene_families())
 
 std::vector<Case> cases(std::size_t points, const std::string& only) {
     std::vector<Case> out;
     for (SceneFamily family : all_scene_families()) {
         FamilyParams p;
         p.points = points;
+        p.gap = family_gap;
         p.layers = family == SceneFamily::Folded ? 4 : 6;
         p.unrolled = unrolled && is_rolled(family);
         const std::string name = family_name(family) + (p.unrolled ? "_unrolled" : "");
@@ -282,12 +286,14 @@ int main(int argc, char** argv) {
             global_order = true;
         else if (key == "--unrolled")
             unrolled = true;
+        else if (key == "--gap")
+            family_gap = std::stod(value());
         else {
             std::fprintf(stderr,
                          "usage: strata_bench_untangle [--family NAME] [--tangle "
                          "naive90|naive95|dp|real] [--backend indexed|grid] [--points N] "
                          "[--timing] [--write DIR] [--slices DIR|none] [--sides | --global-order] "
-                         "[--unrolled]\n");
+                         "[--unrolled] [--gap G]\n");
             return 2;
         }
     }
