@@ -1297,6 +1297,79 @@ std::size_t InputSides::vertex_count(std::size_t a) const {
     return r == kNoLayer ? 0 : recorded_->scene.layer(r).points.size();
 }
 
+namespace {
+
+// InputSides::matched()'s reordering of the matches `match` of `points` (open layer) onto
+// the reference layer `ref`: see there. `exact`: the vertex is its matched reference vertex.
+void match_in_order(const std::vector<Vec2>& points, const std::vector<Vec2>& ref,
+                    const std::vector<char>& exact, std::vector<std::size_t>& match) {
+    const std::size_t n = points.size();
+    std::size_t j = 0;
+    std::size_t lo = 0;  // the reference index of the last unmoved vertex (0: none yet)
+    while (j < n) {
+        if (exact[j]) {
+            lo = match[j];
+            ++j;
+            continue;
+        }
+        std::size_t e = j;
+        while (e < n && !exact[e]) ++e;
+        const std::size_t hi = e < n ? match[e] : ref.size() - 1;
+        bool ordered = lo <= hi;
+        for (std::size_t k = j; k < e && ordered; ++k)
+            ordered = match[k] >= lo && match[k] <= hi && (k == j || match[k - 1] <= match[k]);
+        if (!ordered && lo <= hi &&
+            static_cast<double>(hi - lo + 1) * static_cast<double>(e - j) <= 4e6) {
+            // Candidates per vertex, by reference index; Viterbi over non-decreasing indices.
+            struct Cand {
+                std::size_t k;
+                double d, cost;
+                std::size_t from;
+            };
+            std::vector<std::vector<Cand>> cands(e - j);
+            for (std::size_t v = j; v < e; ++v) {
+                double nearest = kInf;
+                for (std::size_t k = lo; k <= hi; ++k)
+                    nearest = std::min(nearest, std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y));
+                std::vector<Cand>& c = cands[v - j];
+                for (std::size_t k = lo; k <= hi; ++k) {
+                    const double d = std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y);
+                    if (d <= 3.0 * nearest) c.push_back({k, d, kInf, kNone});
+                }
+                if (c.size() > 16) {
+                    std::nth_element(c.begin(), c.begin() + 16, c.end(),
+                                     [](const Cand& x, const Cand& y) { return x.d < y.d; });
+                    c.resize(16);
+                    std::sort(c.begin(), c.end(),
+                              [](const Cand& x, const Cand& y) { return x.k < y.k; });
+                }
+            }
+            for (Cand& c : cands[0]) c.cost = c.d;
+            for (std::size_t r = 1; r < cands.size(); ++r)
+                for (Cand& c : cands[r])
+                    for (std::size_t q = 0; q < cands[r - 1].size(); ++q) {
+                        const Cand& p = cands[r - 1][q];
+                        if (p.k <= c.k && p.cost + c.d < c.cost) {
+                            c.cost = p.cost + c.d;
+                            c.from = q;
+                        }
+                    }
+            std::size_t best = kNone;
+            for (std::size_t q = 0; q < cands.back().size(); ++q)
+                if (cands.back()[q].cost < kInf &&
+                    (best == kNone || cands.back()[q].cost < cands.back()[best].cost))
+                    best = q;
+            for (std::size_t r = cands.size(); best != kNone && r-- > 0;) {
+                match[j + r] = cands[r][best].k;
+                best = cands[r][best].from;
+            }
+        }
+        j = e;
+    }
+}
+
+}  // namespace
+
 InputSides InputSides::matched(const InputSides& recorded, const Scene& reference,
                                const Scene& scene) {
     InputSides out;
@@ -1314,17 +1387,29 @@ InputSides InputSides::matched(const InputSides& recorded, const Scene& referenc
         if (out.layer_[a] == kNoLayer) continue;
         const Layer& ref_layer = reference.layer(ra);
         const SegmentIndex index(ref_layer);
+        const std::vector<Vec2>& ref = ref_layer.points;
+        const std::vector<Vec2>& points = scene.layer(a).points;
         // The reference vertex of each vertex of layer a: the nearer end of its closest segment.
+        std::vector<std::size_t> match(points.size(), 0);
+        std::vector<char> exact(points.size(), 0);  // the vertex is that reference vertex
+        for (std::size_t j = 0; j < points.size(); ++j) {
+            const Nearest nr = nearest_on(index, points[j]);
+            if (!nr.found()) continue;
+            const Vec2 s0 = index.start(nr.segment), s1 = index.end(nr.segment);
+            const bool first = std::hypot(nr.point.x - s0.x, nr.point.y - s0.y) <=
+                               std::hypot(nr.point.x - s1.x, nr.point.y - s1.y);
+            match[j] = first ? nr.segment : (nr.segment + 1) % ref.size();
+            exact[j] = points[j] == ref[match[j]];
+        }
+        // A simplification keeps its vertices in their order. Where the matches of a run of
+        // vertices that moved (untangled) between two that did not are out of that order (a
+        // vertex closest to another sheet of a roll, nearer than it moved), the run takes the
+        // reference vertices in order, between those of its unmoved ends, that are nearest in
+        // all (each vertex choosing among the reference vertices within 3 times its nearest
+        // one's distance; runs whose stretch times length exceeds 4e6 keep their matches).
+        if (!ref_layer.closed) match_in_order(points, ref, exact, match);
         std::vector<std::size_t>& origin = out.origin_[a];
-        for (const Vec2& p : scene.layer(a).points) {
-            const Nearest nr = nearest_on(index, p);
-            std::size_t k = 0;
-            if (nr.found()) {
-                const Vec2 s0 = index.start(nr.segment), s1 = index.end(nr.segment);
-                const bool first = std::hypot(nr.point.x - s0.x, nr.point.y - s0.y) <=
-                                   std::hypot(nr.point.x - s1.x, nr.point.y - s1.y);
-                k = first ? nr.segment : (nr.segment + 1) % ref_layer.points.size();
-            }
+        for (std::size_t k : match) {
             if (!recorded.origin_.empty())
                 k = k < recorded.origin_[ra].size() ? recorded.origin_[ra][k] : kNoLayer;
             origin.push_back(k);

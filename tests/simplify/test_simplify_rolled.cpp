@@ -359,6 +359,45 @@ TEST_CASE("sides matched by nearest vertex (strata check --reference) judge a si
     CHECK(check_scene(pushed, cp).nesting_violation_count > 0);
 }
 
+TEST_CASE("sides matched without the correspondence keep a moved vertex on its own sheet",
+          "[rolled]") {
+    // A rolled around the end of B: its lower sheet (y = 0) under B (y = 1), its upper sheet
+    // (y = 2) over B. In the "output" B moved up to y = 1.8 and a vertex of A's lower sheet
+    // followed it to (6, 1.5): still under B, but nearer the upper sheet of the reference
+    // (0.5) than its own (1.5). Its unmoved neighbours keep it between theirs (the output of
+    // a simplification keeps its vertices' order), on the lower sheet: no violation; moved
+    // over B it is one. Before, the nearest segment gave it the upper sheet's side, over B.
+    auto open = [](const char* name, std::vector<Vec2> points) {
+        Layer layer;
+        layer.name = name;
+        layer.points = std::move(points);
+        return layer;
+    };
+    const Layer a = open("a", {{0, 0}, {2, 0}, {4, 0}, {6, 0}, {8, 0}, {10, 0}, {11, 1}, {10, 2},
+                               {9, 2}, {8, 2}, {7, 2}, {6, 2}, {5, 2}});
+    const Layer b = open("b", {{-1, 1}, {1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1}});
+    const Scene reference({a, b});
+    const InputSides recorded = record_input_sides(reference);
+    CheckParams cp;
+    cp.outside_sides = outside_sides(reference);
+    Layer a_out = open("a", {{0, 0}, {6, 1.5}, {10, 0}, {11, 1}, {10, 2}, {5, 2}});
+    const Layer b_out = open("b", {{-1, 1.8}, {9, 1.8}});
+    const Scene out({a_out, b_out});
+    const InputSides matched = InputSides::matched(recorded, reference, out);
+    cp.input_sides = &matched;
+    const CheckReport ok = check_scene(out, cp);
+    CHECK(ok.crossing_count == 0);
+    CHECK(ok.nesting_violation_count == 0);
+
+    // Over B now (across it): the lower sheet's vertex is on the wrong side.
+    a_out.points[1] = {6, 1.9};
+    const Scene wrong({a_out, b_out});
+    const InputSides matched_wrong = InputSides::matched(recorded, reference, wrong);
+    cp.input_sides = &matched_wrong;
+    const CheckReport bad = check_scene(wrong, cp);
+    CHECK(bad.nesting_violation_count > 0);
+}
+
 TEST_CASE("an untangling of rolled vertices that stalls gives up (only there)", "[rolled]") {
     // The shirt rolled over a jacket's end, random decimation at 90% (the default seed): one
     // removal, the same in both scenes, cannot be untangled (a shirt chord cut into the body).
