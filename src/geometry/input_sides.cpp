@@ -1,5 +1,7 @@
 #include "strata/geometry/input_sides.h"
 
+#include "geometry/detail/segment_index.h"
+
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
@@ -8,8 +10,13 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace strata {
 
@@ -345,6 +352,252 @@ int global_side(Relation relation_of_a_to_b, int outside) {
         default:
             return 0;
     }
+}
+
+using detail::automatic_near;
+using detail::kSideReach;
+using detail::Nearest;
+using detail::nearest_on;
+using detail::SegmentIndex;
+using detail::side_of;
+
+// The recorded sides: decided by the nearest queries and the side rule of check_scene()
+// (geometry/detail/segment_index.h).
+struct InputSides::Recorded {
+    static constexpr signed char kUnknown = 3;  // not found yet
+
+    Scene scene;
+    double reach = 0.0;
+    std::size_t n = 0;
+    // memo[a * n + b][k]: the code of vertex k of layer a against open layer b (kUnknown
+    // until asked for); null where nothing is recorded (b closed, side by side, out of reach).
+    std::vector<std::unique_ptr<std::atomic<signed char>[]>> memo;
+    // The segment index of each open layer, built when first needed.
+    mutable std::vector<std::unique_ptr<SegmentIndex>> indices;
+    std::unique_ptr<std::once_flag[]> built;
+
+    const SegmentIndex& index(std::size_t b) const {
+        std::call_once(built[b],
+                       [&] { indices[b] = std::make_unique<SegmentIndex>(scene.layer(b)); });
+        return *indices[b];
+    }
+
+    int code(std::size_t a, std::size_t k, std::size_t b) const {
+        const std::unique_ptr<std::atomic<signed char>[]>& found = memo[a * n + b];
+        const std::vector<Vec2>& points = scene.layer(a).points;
+        if (!found || k >= points.size()) return 0;
+        signed char c = found[k].load(std::memory_order_relaxed);
+        if (c != kUnknown) return c;
+        // Threads that ask at once find the same value.
+        const SegmentIndex& other = index(b);
+        // Callers ask vertex after vertex: each thread's search starts where its last one
+        // ended on the same layer (the result does not depend on where it starts).
+        thread_local SegmentIndex::Cursor cursor;
+        const Nearest nr = nearest_on(other, points[k], reach, &cursor);
+        const int side = side_of(other, points[k], nr);
+        // Found, not on b, and no side: closest to an end point of b.
+        c = side == 0 && nr.found() && nr.distance > 0.0 ? InputSides::kBeyondEnd
+                                                         : static_cast<signed char>(side);
+        found[k].store(c, std::memory_order_relaxed);
+        return c;
+    }
+};
+
+InputSides record_input_sides(const Scene& scene, const InputSideParams& params) {
+    validate(params);
+    auto r = std::make_shared<InputSides::Recorded>();
+    r->scene = scene;
+    r->reach = params.reach > 0.0 ? params.reach : kSideReach * automatic_near(scene);
+    const std::size_t n = scene.size();
+    r->n = n;
+    r->memo.resize(n * n);
+    r->indices.resize(n);
+    r->built = std::make_unique<std::once_flag[]>(n);
+    std::vector<Box2> bounds;
+    for (std::size_t i = 0; i < n; ++i) bounds.push_back(scene.layer(i).bounds());
+    for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = 0; b < n; ++b) {
+            const Relation rel = a == b ? Relation::Same : scene.relation(a, b);
+            if (scene.layer(b).closed || (rel != Relation::Under && rel != Relation::Over) ||
+                !bounds[a].overlaps(bounds[b].inflated(r->reach)))
+                continue;
+            const std::size_t count = scene.layer(a).points.size();
+            auto& found = r->memo[a * n + b];
+            found = std::make_unique<std::atomic<signed char>[]>(count);
+            for (std::size_t k = 0; k < count; ++k)
+                found[k].store(InputSides::Recorded::kUnknown, std::memory_order_relaxed);
+        }
+    InputSides out;
+    out.n_ = n;
+    out.recorded_ = std::move(r);
+    return out;
+}
+
+InputSides InputSides::from_codes(const Scene& scene, std::vector<std::vector<signed char>> codes) {
+    auto r = std::make_shared<InputSides::Recorded>();
+    r->scene = scene;
+    const std::size_t n = scene.size();
+    r->n = n;
+    r->memo.resize(n * n);
+    r->indices.resize(n);
+    r->built = std::make_unique<std::once_flag[]>(n);
+    for (std::size_t p = 0; p < n * n && p < codes.size(); ++p) {
+        const std::vector<signed char>& from = codes[p];
+        if (from.empty()) continue;
+        // Every code known: no query is ever made.
+        const std::size_t count = scene.layer(p / n).points.size();
+        auto& found = r->memo[p];
+        found = std::make_unique<std::atomic<signed char>[]>(count);
+        for (std::size_t k = 0; k < count; ++k)
+            found[k].store(k < from.size() ? from[k] : 0, std::memory_order_relaxed);
+    }
+    InputSides out;
+    out.n_ = n;
+    out.recorded_ = std::move(r);
+    return out;
+}
+
+int InputSides::code(std::size_t a, std::size_t k, std::size_t b) const {
+    if (a >= n_ || b >= n_ || !recorded_) return 0;
+    if (!origin_.empty()) {
+        if (k >= origin_[a].size()) return 0;
+        k = origin_[a][k];
+    }
+    if (!layer_.empty()) {
+        a = layer_[a];
+        b = layer_[b];
+        if (a == kNoLayer || b == kNoLayer) return 0;
+    }
+    return recorded_->code(a, k, b);
+}
+
+std::size_t InputSides::vertex_count(std::size_t a) const {
+    if (a >= n_ || !recorded_) return 0;
+    if (!origin_.empty()) return origin_[a].size();
+    const std::size_t r = layer_.empty() ? a : layer_[a];
+    return r == kNoLayer ? 0 : recorded_->scene.layer(r).points.size();
+}
+
+namespace {
+
+// InputSides::matched()'s reordering of the matches `match` of `points` (open layer) onto
+// the reference layer `ref`: see there. `exact`: the vertex is its matched reference vertex.
+void match_in_order(const std::vector<Vec2>& points, const std::vector<Vec2>& ref,
+                    const std::vector<char>& exact, std::vector<std::size_t>& match) {
+    const std::size_t n = points.size();
+    std::size_t j = 0;
+    std::size_t lo = 0;  // the reference index of the last unmoved vertex (0: none yet)
+    while (j < n) {
+        if (exact[j]) {
+            lo = match[j];
+            ++j;
+            continue;
+        }
+        std::size_t e = j;
+        while (e < n && !exact[e]) ++e;
+        const std::size_t hi = e < n ? match[e] : ref.size() - 1;
+        bool ordered = lo <= hi;
+        for (std::size_t k = j; k < e && ordered; ++k)
+            ordered = match[k] >= lo && match[k] <= hi && (k == j || match[k - 1] <= match[k]);
+        if (!ordered && lo <= hi &&
+            static_cast<double>(hi - lo + 1) * static_cast<double>(e - j) <= 4e6) {
+            // Candidates per vertex, by reference index; Viterbi over non-decreasing indices.
+            struct Cand {
+                std::size_t k;
+                double d, cost;
+                std::size_t from;
+            };
+            std::vector<std::vector<Cand>> cands(e - j);
+            for (std::size_t v = j; v < e; ++v) {
+                double nearest = detail::kFar;
+                for (std::size_t k = lo; k <= hi; ++k)
+                    nearest = std::min(nearest,
+                                       std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y));
+                std::vector<Cand>& c = cands[v - j];
+                for (std::size_t k = lo; k <= hi; ++k) {
+                    const double d = std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y);
+                    if (d <= 3.0 * nearest) c.push_back({k, d, detail::kFar, detail::kNoSegment});
+                }
+                if (c.size() > 16) {
+                    std::nth_element(c.begin(), c.begin() + 16, c.end(),
+                                     [](const Cand& x, const Cand& y) { return x.d < y.d; });
+                    c.resize(16);
+                    std::sort(c.begin(), c.end(),
+                              [](const Cand& x, const Cand& y) { return x.k < y.k; });
+                }
+            }
+            for (Cand& c : cands[0]) c.cost = c.d;
+            for (std::size_t r = 1; r < cands.size(); ++r)
+                for (Cand& c : cands[r])
+                    for (std::size_t q = 0; q < cands[r - 1].size(); ++q) {
+                        const Cand& p = cands[r - 1][q];
+                        if (p.k <= c.k && p.cost + c.d < c.cost) {
+                            c.cost = p.cost + c.d;
+                            c.from = q;
+                        }
+                    }
+            std::size_t best = detail::kNoSegment;
+            for (std::size_t q = 0; q < cands.back().size(); ++q)
+                if (cands.back()[q].cost < detail::kFar &&
+                    (best == detail::kNoSegment || cands.back()[q].cost < cands.back()[best].cost))
+                    best = q;
+            for (std::size_t r = cands.size(); best != detail::kNoSegment && r-- > 0;) {
+                match[j + r] = cands[r][best].k;
+                best = cands[r][best].from;
+            }
+        }
+        j = e;
+    }
+}
+
+}  // namespace
+
+InputSides InputSides::matched(const InputSides& recorded, const Scene& reference,
+                               const Scene& scene) {
+    InputSides out;
+    if (recorded.empty()) return out;
+    const std::size_t n = scene.size();
+    out.n_ = n;
+    out.recorded_ = recorded.recorded_;
+    out.layer_.assign(n, kNoLayer);
+    out.origin_.assign(n, {});
+    for (std::size_t a = 0; a < n; ++a) {
+        const std::optional<std::size_t> namesake = reference.find(scene.layer(a).name);
+        if (!namesake || *namesake >= recorded.n_) continue;
+        const std::size_t ra = *namesake;
+        out.layer_[a] = recorded.layer_.empty() ? ra : recorded.layer_[ra];
+        if (out.layer_[a] == kNoLayer) continue;
+        const Layer& ref_layer = reference.layer(ra);
+        const SegmentIndex index(ref_layer);
+        const std::vector<Vec2>& ref = ref_layer.points;
+        const std::vector<Vec2>& points = scene.layer(a).points;
+        // The reference vertex of each vertex of layer a: the nearer end of its closest segment.
+        std::vector<std::size_t> match(points.size(), 0);
+        std::vector<char> exact(points.size(), 0);  // the vertex is that reference vertex
+        for (std::size_t j = 0; j < points.size(); ++j) {
+            const Nearest nr = nearest_on(index, points[j]);
+            if (!nr.found()) continue;
+            const Vec2 s0 = index.start(nr.segment), s1 = index.end(nr.segment);
+            const bool first = std::hypot(nr.point.x - s0.x, nr.point.y - s0.y) <=
+                               std::hypot(nr.point.x - s1.x, nr.point.y - s1.y);
+            match[j] = first ? nr.segment : (nr.segment + 1) % ref.size();
+            exact[j] = points[j] == ref[match[j]];
+        }
+        // A simplification keeps its vertices in their order. Where the matches of a run of
+        // vertices that moved (untangled) between two that did not are out of that order (a
+        // vertex closest to another sheet of a roll, nearer than it moved), the run takes the
+        // reference vertices in order, between those of its unmoved ends, that are nearest in
+        // all (each vertex choosing among the reference vertices within 3 times its nearest
+        // one's distance; runs whose stretch times length exceeds 4e6 keep their matches).
+        if (!ref_layer.closed) match_in_order(points, ref, exact, match);
+        std::vector<std::size_t>& origin = out.origin_[a];
+        for (std::size_t k : match) {
+            if (!recorded.origin_.empty())
+                k = k < recorded.origin_[ra].size() ? recorded.origin_[ra][k] : kNoLayer;
+            origin.push_back(k);
+        }
+    }
+    return out;
 }
 
 }  // namespace strata
