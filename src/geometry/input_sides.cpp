@@ -20,8 +20,6 @@
 
 namespace strata {
 
-// record_input_sides() is defined in checks.cpp, with the side rule of check_scene().
-
 void validate(const InputSideParams& params) {
     if (!std::isfinite(params.reach) || params.reach < 0.0)
         throw InvalidInput("input sides: params.reach must be a finite value >= 0 (got " +

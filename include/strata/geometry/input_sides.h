@@ -61,8 +61,10 @@ class InputSides {
     /// The sides for `scene`, whose layers are those of `reference` (the scene these sides were
     /// recorded in) matched by name, when the vertex correspondence is not known (`strata
     /// check --reference`): each vertex takes the sides of the reference vertex that ends the
-    /// closest segment of its layer's reference nearest to it. Layers without a namesake get
-    /// none. Defined in checks.cpp (nearest queries).
+    /// closest segment of its layer's reference nearest to it, except that on an open layer a
+    /// run of vertices that moved (not on a reference vertex), between two that did not, whose
+    /// matches leave the reference's order (a vertex nearer another sheet of a roll) takes the
+    /// reference vertices in order nearest in all. Layers without a namesake get none.
     static InputSides matched(const InputSides& recorded, const Scene& reference,
                               const Scene& scene);
     /// The same sides made consistent along each layer, for sides recorded in a scene that is
@@ -105,14 +107,14 @@ class InputSides {
 
   private:
     static constexpr signed char kBeyondEnd = 2;
-    /// The recorded scene, its segment indices and the sides found so far (checks.cpp).
+    /// The recorded scene, its segment indices and the sides found so far (input_sides.cpp).
     struct Recorded;
     /// The side code of vertex k of layer a against layer b (0, +-1 or kBeyondEnd).
     int code(std::size_t a, std::size_t k, std::size_t b) const;
     /// Vertices of layer a of the scene these sides are for.
     std::size_t vertex_count(std::size_t a) const;
     /// Sides for `scene` given as codes: codes[a * n + b][k] for vertex k of layer a against
-    /// layer b (empty: none). Defined in checks.cpp.
+    /// layer b (empty: none).
     static InputSides from_codes(const Scene& scene, std::vector<std::vector<signed char>> codes);
     /// One other reading of a region (region_alternatives()): pair a * n + b, the region's
     /// first vertex, its vertices' sides, and the agreement score it is ordered by.
