@@ -508,7 +508,13 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
                 first = report;
                 first_scene = std::move(attempt);
             }
-            continue;
+            // Without rolled regions the inferred sides are the global order's, but for the
+            // vertices they give no side (around an end of the other layer, a tie): there only
+            // the distance counts. A fold cut by the decimation (the folded scenes) can come
+            // out clean so where the global order, pushing those vertices too, does not.
+            if (rolled || !clean_try(with_sides, keep_simple, attempt, report)) continue;
+            report.inferred_sides = true;
+            if (kept) *kept = std::move(inferred);
         }
         report.passes = passes;
         report.rounds = rounds;

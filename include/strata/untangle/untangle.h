@@ -206,18 +206,19 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// (a part rolled or folded over an open layer, which the global order pushes back), by the
 /// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
 /// rolled; that result is kept when it is clean against those sides (report.inferred_sides).
-/// Otherwise, or when it is not clean, by the global order (untangle() from the input). When
-/// neither is clean, by each of the first 4 other readings of the inferred regions
-/// (InputSides::region_alternatives() of the input's recorded sides: a region whose vertices'
-/// sides disagree, split in two or given the other side), first as untangle()'s first
-/// try, then as its second; the first round with a clean result keeps the clean one that moves
-/// a vertex least (report.inferred_sides, `kept` those sides). When every try fails, they all
-/// run once more with params.long_rounds_factor times the gradient steps (report.long_rounds).
-/// With params.input_sides given,
-/// this is untangle(). Same params, progress and throws as
-/// untangle(). `kept`: if given, receives the inferred sides when they were kept, for judging
-/// the result (check_scene() with them and params' outside sides, or outside_sides() of the
-/// input); left alone otherwise.
+/// Otherwise, or when it is not clean, by the global order (untangle() from the input); where
+/// nothing is read rolled and the global order's try is not clean, by the inferred sides, which
+/// are then the global order's but give no side to the vertices around another layer's end
+/// (there only the distance counts), each first try before the second. When neither is clean, by
+/// each of the first 4 other readings of the inferred regions (InputSides::region_alternatives() of
+/// the input's recorded sides: a region whose vertices' sides disagree, split in two or given the
+/// other side), first as untangle()'s first try, then as its second; the first round with a clean
+/// result keeps the clean one that moves a vertex least (report.inferred_sides, `kept` those
+/// sides). When every try fails, they all run once more with params.long_rounds_factor times the
+/// gradient steps (report.long_rounds). With params.input_sides given, this is untangle(). Same
+/// params, progress and throws as untangle(). `kept`: if given, receives the inferred sides when
+/// they were kept, for judging the result (check_scene() with them and params' outside sides, or
+/// outside_sides() of the input); left alone otherwise.
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params = {},
                                         const ProgressFn& progress = {},
                                         InputSides* kept = nullptr);
