@@ -63,11 +63,10 @@ TEST_CASE("region_alternatives: none where every region's vertices agree", "[unt
     CHECK(record_input_sides(stack).region_alternatives(stack).empty());
 }
 
-TEST_CASE("by_region: a closed loop within reach takes the side of its bulk, not its vote",
-          "[untangle][sides]") {
-    // b: a straight open layer along y = 0 (its right side, +1, is y < 0). a: a closed loop
-    // crossing it, three vertices a hair below it and two well above: one region (its sides
-    // change across b), whose vertices vote +1 and whose centroid lies above (-1).
+// b: a straight open layer along y = 0 (its right side, +1, is y < 0). a: a closed loop
+// crossing it, three vertices a hair below it and two well above.
+namespace {
+Scene loop_across_line() {
     Layer a;
     a.name = "a";
     a.closed = true;
@@ -75,7 +74,15 @@ TEST_CASE("by_region: a closed loop within reach takes the side of its bulk, not
     Layer b;
     b.name = "b";
     b.points = {{0.0, 0.0}, {2.0, 0.0}, {4.0, 0.0}, {6.0, 0.0}, {8.0, 0.0}, {10.0, 0.0}};
-    const Scene scene({a, b});
+    return Scene({a, b});
+}
+}  // namespace
+
+TEST_CASE("by_region: a closed loop within reach takes the side of its bulk, not its vote",
+          "[untangle][sides]") {
+    // The loop of loop_across_line() is one region (its sides change across b), whose
+    // vertices vote +1 and whose centroid lies above (-1).
+    const Scene scene = loop_across_line();
     const InputSides recorded = record_input_sides(scene);
     REQUIRE(sides_of(recorded, scene, 0, 1) == "+++--");
     CHECK(sides_of(recorded.by_region(scene), scene, 0, 1) == "-----");
@@ -86,9 +93,9 @@ TEST_CASE("by_region: a closed loop within reach takes the side of its bulk, not
 
     // A loop as wide as the open layer is long (diagonal 8.1 against 10: more than half of
     // it), wrapped by all of it rather than held in a fold: it keeps its vertices' vote.
-    Layer wide_a = a;
+    Layer wide_a = scene.layer(0);
     wide_a.points = {{1.0, -0.02}, {5.0, -0.02}, {9.0, -0.02}, {9.0, 1.0}, {1.0, 1.0}};
-    const Scene wide({wide_a, b});
+    const Scene wide({wide_a, scene.layer(1)});
     const InputSides wide_recorded = record_input_sides(wide);
     REQUIRE(sides_of(wide_recorded, wide, 0, 1) == "+++--");
     CHECK(sides_of(wide_recorded.by_region(wide), wide, 0, 1) == "+++++");
@@ -302,14 +309,7 @@ TEST_CASE("by_region: a loop along one arm of an open layer is left to the centr
           "[untangle][sides]") {
     // No fold: every segment of b near the loop runs the same way, and the side of both arms
     // does not apply (the loop of "a closed loop within reach takes the side of its bulk").
-    Layer a;
-    a.name = "a";
-    a.closed = true;
-    a.points = {{3.0, -0.02}, {5.0, -0.02}, {7.0, -0.02}, {7.0, 1.0}, {3.0, 1.0}};
-    Layer b;
-    b.name = "b";
-    b.points = {{0.0, 0.0}, {2.0, 0.0}, {4.0, 0.0}, {6.0, 0.0}, {8.0, 0.0}, {10.0, 0.0}};
-    const Scene scene({a, b});
+    const Scene scene = loop_across_line();
     CHECK(sides_of(record_input_sides(scene).by_region(scene, outside_sides(scene)), scene, 0, 1) ==
           "-----");
 }
