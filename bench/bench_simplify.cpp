@@ -295,6 +295,13 @@ std::vector<std::size_t> numbers(const std::string& list) {
     return out;
 }
 
+// A finite number >= 0, the whole of `text`.
+bool is_margin(const std::string& text) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    return !text.empty() && *end == '\0' && std::isfinite(v) && v >= 0.0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -311,8 +318,8 @@ int main(int argc, char** argv) {
                 only = value;
             } else if (key == "--stretch" && (value == "long" || value == "short")) {
                 stretch = value;
-            } else if (key == "--margin" && std::atof(value.c_str()) >= 0.0) {
-                margins.push_back(std::atof(value.c_str()));
+            } else if (key == "--margin" && is_margin(value)) {
+                margins.push_back(std::strtod(value.c_str(), nullptr));
             } else {
                 std::fprintf(stderr, "strata_bench_simplify: bad paper option %s %s\n", key.c_str(),
                              value.c_str());

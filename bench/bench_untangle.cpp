@@ -121,7 +121,7 @@ struct Case {
     Scene input;
 };
 
-bool unrolled = false;  // --unrolled
+bool unrolled = false;    // --unrolled
 double family_gap = 2.0;  // --gap (FamilyParams::gap, the families of all_scene_families())
 
 std::vector<Case> cases(std::size_t points, const std::string& only) {
@@ -266,6 +266,20 @@ int main(int argc, char** argv) {
             }
             return argv[++i];
         };
+        // A number > 0 (whole for --points), or exit 2 naming the option and the value.
+        auto positive = [&](bool whole) {
+            const std::string text = value();
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !std::isfinite(v) || !(v > 0.0) ||
+                (whole && v != std::floor(v))) {
+                std::fprintf(stderr,
+                             "strata_bench_untangle: %s must be a%s number > 0 (got '%s')\n",
+                             key.c_str(), whole ? " whole" : "", text.c_str());
+                std::exit(2);
+            }
+            return v;
+        };
         if (key == "--family")
             family = value();
         else if (key == "--tangle")
@@ -273,7 +287,7 @@ int main(int argc, char** argv) {
         else if (key == "--backend")
             backend = value();
         else if (key == "--points")
-            points = static_cast<std::size_t>(std::stoul(value()));
+            points = static_cast<std::size_t>(positive(true));
         else if (key == "--timing")
             timed = true;
         else if (key == "--write")
@@ -287,7 +301,7 @@ int main(int argc, char** argv) {
         else if (key == "--unrolled")
             unrolled = true;
         else if (key == "--gap")
-            family_gap = std::stod(value());
+            family_gap = positive(false);
         else {
             std::fprintf(stderr,
                          "usage: strata_bench_untangle [--family NAME] [--tangle "
