@@ -506,16 +506,15 @@ void match_in_order(const std::vector<Vec2>& points, const std::vector<Vec2>& re
                 std::size_t from;
             };
             std::vector<std::vector<Cand>> cands(e - j);
+            std::vector<double> distance(hi - lo + 1);  // of vertex v to reference vertex lo + i
             for (std::size_t v = j; v < e; ++v) {
-                double nearest = detail::kFar;
                 for (std::size_t k = lo; k <= hi; ++k)
-                    nearest = std::min(nearest,
-                                       std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y));
+                    distance[k - lo] = std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y);
+                const double nearest = *std::min_element(distance.begin(), distance.end());
                 std::vector<Cand>& c = cands[v - j];
-                for (std::size_t k = lo; k <= hi; ++k) {
-                    const double d = std::hypot(points[v].x - ref[k].x, points[v].y - ref[k].y);
-                    if (d <= 3.0 * nearest) c.push_back({k, d, detail::kFar, detail::kNoSegment});
-                }
+                for (std::size_t k = lo; k <= hi; ++k)
+                    if (distance[k - lo] <= 3.0 * nearest)
+                        c.push_back({k, distance[k - lo], detail::kFar, detail::kNoSegment});
                 if (c.size() > 16) {
                     std::nth_element(c.begin(), c.begin() + 16, c.end(),
                                      [](const Cand& x, const Cand& y) { return x.d < y.d; });
