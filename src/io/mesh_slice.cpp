@@ -612,9 +612,36 @@ void validate_stl_text(const std::filesystem::path& path, std::istream& in) {
     }
 }
 
+// A PLY file's layout as its header declares it.
+struct PlyProperty {
+    std::string name;
+    bool list = false;
+    std::string count_type;  // lists only
+    std::string type;        // a scalar's type, or a list's item type
+};
+struct PlyElement {
+    std::string name;
+    long long count = 0;
+    std::vector<PlyProperty> properties;
+};
+struct PlyLayout {
+    bool ascii = true, big_endian = false;
+    std::size_t header_lines = 0;
+    std::vector<PlyElement> elements;
+};
+
+// Bytes of a PLY scalar type (a type the header check accepted).
+std::size_t ply_type_size(const std::string& type) {
+    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "double" || type == "float64") return 8;
+    return 4;
+}
+
 // The PLY header, checked line by line before OpenMesh sees it: OpenMesh 9 loops forever on
 // some malformed headers (a format line whose version is not a number, found by fuzz_mesh).
-void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
+// Leaves `in` at the first byte after the end_header line.
+PlyLayout validate_ply_header(const std::filesystem::path& path, std::istream& in) {
     static const std::set<std::string> types = {
         "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
         "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
@@ -632,6 +659,7 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
             mesh_text_error(path, at, std::string("expected '") + form + "'");
         }
     };
+    PlyLayout layout;
     std::string line;
     std::size_t n = 0;
     bool format = false, element = false;
@@ -649,7 +677,8 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
         if (key == "comment" || key == "obj_info") continue;
         if (key == "end_header") {
             if (!format) mesh_text_error(path, tokens[0], "the PLY header has no format line");
-            return;
+            layout.header_lines = n;
+            return layout;
         }
         if (key == "format") {
             expect_count(tokens, 3, "format ascii|binary_little_endian|binary_big_endian 1.0");
@@ -663,6 +692,8 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
                     path, tokens[2],
                     "unsupported PLY version '" + shown_token(tokens[2].text) + "' (expected 1.0)");
             format = true;
+            layout.ascii = tokens[1].text == "ascii";
+            layout.big_endian = tokens[1].text == "binary_big_endian";
         } else if (key == "element") {
             expect_count(tokens, 3, "element NAME COUNT");
             element = true;
@@ -676,6 +707,7 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
                 mesh_text_error(path, tokens[2],
                                 "count " + tokens[2].text + " is more than the file holds (" +
                                     std::to_string(file_size) + " bytes)");
+            layout.elements.push_back({tokens[1].text, count, {}});
         } else if (key == "property") {
             // OpenMesh dereferences the current element (found by fuzz_mesh: a SEGV).
             if (!element) mesh_text_error(path, tokens[0], "a property before any element line");
@@ -683,9 +715,17 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
                 expect_count(tokens, 5, "property list COUNT_TYPE TYPE NAME");
                 check_type(tokens[2]);
                 check_type(tokens[3]);
+                if (tokens[2].text.find("float") != std::string::npos || tokens[2].text == "double")
+                    mesh_text_error(path, tokens[2],
+                                    "a list's length type must be an integer type (got '" +
+                                        tokens[2].text + "')");
+                layout.elements.back().properties.push_back(
+                    {tokens[4].text, true, tokens[2].text, tokens[3].text});
             } else {
                 expect_count(tokens, 3, "property TYPE NAME");
                 check_type(tokens[1]);
+                layout.elements.back().properties.push_back(
+                    {tokens[2].text, false, "", tokens[1].text});
             }
         } else {
             mesh_text_error(path, tokens[0], "unknown PLY header line '" + shown_token(key) + "'");
@@ -694,9 +734,92 @@ void validate_ply_header(const std::filesystem::path& path, std::istream& in) {
     mesh_text_error(path, {"", n, 1}, "the PLY header has no end_header line");
 }
 
+// The PLY data walked element by element as `layout` declares it, each list's length checked
+// against what the file still holds: OpenMesh reserves a list's declared length before reading
+// it (fuzz_mesh: a face of 2^28 indices in a 200-byte file took 1 GB, a face of 10^8 in ASCII
+// grew to 2.5 GB). ASCII errors name line and column, binary ones the byte offset.
+void validate_ply_body(const std::filesystem::path& path, std::istream& in,
+                       const PlyLayout& layout) {
+    const std::string what_ends = "the file ends before its data does (";
+    auto where = [](const PlyElement& e, long long k, const PlyProperty& p) {
+        return "element '" + shown_token(e.name) + "' " + std::to_string(k) + " of " +
+               std::to_string(e.count) + ", property '" + shown_token(p.name) + "'";
+    };
+    if (layout.ascii) {
+        std::string line;
+        std::vector<TextToken> tokens;
+        std::size_t line_number = layout.header_lines, next = 0;
+        auto take = [&](const std::string& at) -> const TextToken& {
+            while (next == tokens.size()) {
+                if (!std::getline(in, line))
+                    mesh_text_error(path, {"", line_number + 1, 1}, what_ends + at + ")");
+                tokens = line_tokens(line, ++line_number);
+                next = 0;
+            }
+            return tokens[next++];
+        };
+        for (const PlyElement& e : layout.elements)
+            for (long long k = 0; k < e.count; ++k)
+                for (const PlyProperty& p : e.properties) {
+                    if (!p.list) {
+                        take(where(e, k, p));
+                        continue;
+                    }
+                    const TextToken& t = take(where(e, k, p));
+                    const long long length = integer_token(path, t, t.text, "a list length");
+                    if (length < 0)
+                        mesh_text_error(path, t, "list length is negative (got '" + t.text + "')");
+                    const TextToken at = t;
+                    for (long long i = 0; i < length; ++i) {
+                        if (next == tokens.size() && in.peek() == EOF)
+                            mesh_text_error(path, at,
+                                            "list length " + at.text +
+                                                " is more than the file holds (" + where(e, k, p) +
+                                                ")");
+                        take(where(e, k, p));
+                    }
+                }
+        return;
+    }
+    std::error_code ec;
+    const auto file_size = static_cast<std::uint64_t>(std::filesystem::file_size(path, ec));
+    const std::streamoff at = in.tellg();  // -1 when the header is the whole file
+    std::uint64_t offset = at < 0 ? file_size : static_cast<std::uint64_t>(at);
+    auto fail = [&](const std::string& what) -> void {
+        throw InvalidInput(path.string() + ": byte " + std::to_string(offset) + ": " + what);
+    };
+    for (const PlyElement& e : layout.elements)
+        for (long long k = 0; k < e.count; ++k)
+            for (const PlyProperty& p : e.properties) {
+                const std::uint64_t left = file_size - std::min(offset, file_size);
+                if (!p.list) {
+                    const std::size_t size = ply_type_size(p.type);
+                    if (size > left) fail(what_ends + where(e, k, p) + ")");
+                    offset += size;
+                    continue;
+                }
+                const std::size_t size = ply_type_size(p.count_type);
+                if (size > left) fail(what_ends + where(e, k, p) + ")");
+                unsigned char bytes[8] = {};
+                in.seekg(static_cast<std::streamoff>(offset));
+                in.read(reinterpret_cast<char*>(bytes), static_cast<std::streamsize>(size));
+                std::uint64_t raw = 0;
+                for (std::size_t b = 0; b < size; ++b)
+                    raw |= std::uint64_t{bytes[layout.big_endian ? size - 1 - b : b]} << (8 * b);
+                const bool is_signed = p.count_type[0] != 'u';
+                const bool negative = is_signed && (raw >> (8 * size - 1)) != 0;
+                if (negative) fail("list length is negative (" + where(e, k, p) + ")");
+                const std::uint64_t item = ply_type_size(p.type);
+                if (raw > (left - size) / item)
+                    fail("list length " + std::to_string(raw) + " is more than the file holds (" +
+                         where(e, k, p) + ")");
+                offset += size + raw * item;
+            }
+}
+
 // Refuses non-finite coordinates and faces naming missing vertices in OBJ, plain OFF and ASCII
-// STL files, and malformed PLY headers, with the file's line and column; the rest is left to
-// OpenMesh.
+// STL files, and malformed PLY headers and list lengths, with the file's line and column (byte
+// offset in binary PLY); the rest is left to OpenMesh.
 void validate_mesh_text(const std::filesystem::path& path, const std::string& ext) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return;
@@ -705,7 +828,7 @@ void validate_mesh_text(const std::filesystem::path& path, const std::string& ex
     else if (ext == ".stl")
         validate_stl_text(path, in);
     else if (ext == ".ply")
-        validate_ply_header(path, in);
+        validate_ply_body(path, in, validate_ply_header(path, in));
 }
 
 }  // namespace

@@ -336,7 +336,7 @@ TEST_CASE("reading errors name the file", "[mesh_slice]") {
     CHECK(capture.err.str().empty());
 }
 
-TEST_CASE("malformed PLY and OFF headers are refused with line and column (fuzz_mesh)",
+TEST_CASE("malformed PLY and OFF files are refused with line and column or byte (fuzz_mesh)",
           "[mesh_slice]") {
     // OpenMesh 9 looped forever on "format ascii !.0" (fuzz/regressions/mesh).
     const std::string body =
@@ -369,6 +369,40 @@ TEST_CASE("malformed PLY and OFF headers are refused with line and column (fuzz_
     CHECK_THROWS_WITH(read_slice_mesh(write("magic.off", std::string("OFF\b0\n1 1 0\n0 0 0\n"
                                                                      "-3 1 2 4\n"))),
                       Contains("magic.off:1:1") && Contains("not an OFF header"));
+    // A list longer than the rest of the file (OpenMesh reserved its declared length: 1 GB
+    // from a 200-byte file, fuzz/regressions/mesh); a list length of a float type.
+    const std::string head =
+        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list int int vertex_indices\nend_header\n";
+    CHECK_THROWS_WITH(read_slice_mesh(write("long.ply", "ply\nformat ascii 1.0\n" + head +
+                                                            "0 0 0\n1 0 1\n0 1 1\n"
+                                                            "99999999 0 1 2\n")),
+                      Contains("long.ply:13:1") && Contains("list length 99999999") &&
+                          Contains("element 'face' 0 of 1"));
+    std::string binary = "ply\nformat binary_little_endian 1.0\n" + head;
+    binary += std::string(36, '\0');               // three vertices (167 header bytes)
+    binary += std::string("\x03\x00\x00\x10", 4);  // 2^28 + 3 indices
+    binary += std::string(12, '\0');
+    CHECK_THROWS_WITH(read_slice_mesh(write("long_binary.ply", binary)),
+                      Contains("long_binary.ply: byte 203") && Contains("list length 268435459"));
+    CHECK_THROWS_WITH(
+        read_slice_mesh(write("short.ply", "ply\nformat ascii 1.0\n" + head + "0 0 0\n1 0 1\n")),
+        Contains("short.ply:12:1") && Contains("ends before its data"));
+    CHECK_THROWS_WITH(
+        read_slice_mesh(write("float_length.ply",
+                              "ply\nformat ascii 1.0\nelement face 1\n"
+                              "property list float int vertex_indices\nend_header\n")),
+        Contains("float_length.ply:4:15") && Contains("integer type"));
+    // The same file with a list that fits reads, in ASCII and in binary.
+    CHECK(read_slice_mesh(write("fits.ply", "ply\nformat ascii 1.0\n" + head +
+                                                "0 0 0\n1 0 1\n0 1 1\n3 0 1 2\n"))
+              .triangles.size() == 1);
+    binary.resize(binary.size() - 16);
+    const float corners[9] = {0, 0, 0, 1, 0, 1, 0, 1, 1};  // written as the host has them (x86)
+    const std::int32_t face[4] = {3, 0, 1, 2};
+    binary.replace(binary.size() - 36, 36, reinterpret_cast<const char*>(corners), 36);
+    binary.append(reinterpret_cast<const char*>(face), 16);
+    CHECK(read_slice_mesh(write("fits_binary.ply", binary)).triangles.size() == 1);
     // A valid header still reads (CRLF line ends and comments included).
     const SliceMesh ok = read_slice_mesh(
         write("ok.ply", "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\n" + body));
