@@ -1,12 +1,13 @@
 #!/bin/bash
 # Out-of-sample judge of `strata untangle` (issues 13 and 19), on seeds other than the
-# benchmark's: the 12 generated families of strata_bench_untangle at 300 points a layer,
+# benchmark's: the 12 generated families of strata_bench_untangle at 300 points a layer (POINTS),
 # decimated naively at random (90% and 95%) with each seed, untangled with `strata untangle`
 # (sides inferred, no original), then judged by `strata check --reference ORIGINAL`: clean
 # means no crossing, the gaps kept and every vertex on the original's side of its neighbours.
 #
 #   bench/out_of_sample.sh BUILD WORK [SEEDS...]        default seeds 2 3 4 5 6
 #   REFERENCE=1 bench/out_of_sample.sh BUILD WORK ...   untangle with --reference ORIGINAL too
+#   POINTS=600 bench/out_of_sample.sh BUILD WORK ...    inputs of 600 points a layer
 #
 # BUILD: a build folder with tools/strata and bench/strata_bench_untangle; WORK: a folder for
 # the inputs and outputs. Prints each dirty case with the untangling's exit code (0: a wrong
@@ -23,9 +24,16 @@ seeds=("$@")
 [ ${#seeds[@]} -gt 0 ] || seeds=(2 3 4 5 6)
 strata=$build/tools/strata
 mkdir -p "$work/inputs" "$work/out"
+points=${POINTS:-300}
+# The inputs are written once per WORK folder; a folder of other points is refused.
+if [ -e "$work/inputs/points" ] && [ "$(cat "$work/inputs/points")" != "$points" ]; then
+    echo "$0: $work holds inputs of $(cat "$work/inputs/points") points, not $points" >&2
+    exit 2
+fi
 if [ ! -e "$work/inputs/stack-naive90.input.json" ]; then
-    "$build/bench/strata_bench_untangle" --points 300 --slices none --write "$work/inputs" \
+    "$build/bench/strata_bench_untangle" --points "$points" --slices none --write "$work/inputs" \
         >/dev/null
+    echo "$points" >"$work/inputs/points"
 fi
 families="stack folded jacket legs loops stack_5x_gap_0.5 stack_12x_gap_4.0 rolled_both rolled
 rolled_twice shirt_roll collar_wrap"
