@@ -336,7 +336,15 @@ struct Subpath {
 // Builds subpaths from drawing commands given in the element's local coordinates.
 class PathBuilder {
   public:
-    PathBuilder(const OutputMap& map, double tolerance) : map_(map), tol_(tolerance) {}
+    // `curve_points`: vertices made by flattening so far in the document, at most
+    // `max_curve_points` (else InvalidInput at `origin`).
+    PathBuilder(const OutputMap& map, double tolerance, std::size_t& curve_points,
+                std::size_t max_curve_points, const Origin& origin)
+        : map_(map),
+          tol_(tolerance),
+          curve_points_(curve_points),
+          max_curve_points_(max_curve_points),
+          origin_(origin) {}
 
     void move_to(const Vec2& p) {
         flush();
@@ -350,7 +358,9 @@ class PathBuilder {
     // Cubic from the current point; the control points and `to` are local.
     void cubic_to(const Vec2& c1, const Vec2& c2, const Vec2& to) {
         const Vec2 from = current_.points.back();
+        const std::size_t before = current_.points.size();
         flatten_cubic(from, map_(c1), map_(c2), map_(to), tol_, 0, current_.points);
+        count_curve_points(current_.points.size() - before);
         current_.has_segments = true;
     }
     // Quadratic from `from` (the local current point), raised to a cubic.
@@ -401,6 +411,7 @@ class PathBuilder {
         const double h = std::min(kPi / 4.0, h0 / std::sqrt(1.0 + h0 / 3.0));
         const double pieces = std::min(kMaxArcSegments, std::ceil(std::abs(dtheta) / (2.0 * h)));
         const std::size_t n = std::max<std::size_t>(1, static_cast<std::size_t>(pieces));
+        count_curve_points(n - 1);
         for (std::size_t i = 1; i < n; ++i) {
             const double t = theta1 + dtheta * static_cast<double>(i) / static_cast<double>(n);
             const Vec2 local(rx * std::cos(t), ry * std::sin(t));
@@ -424,6 +435,16 @@ class PathBuilder {
     }
 
   private:
+    void count_curve_points(std::size_t added) {
+        curve_points_ += added;
+        if (curve_points_ > max_curve_points_)
+            fail(origin_, "flattening the curves and arcs takes more than " +
+                              std::to_string(max_curve_points_) +
+                              " vertices in the document (curves far larger than the flatten "
+                              "tolerance " +
+                              format_number(tol_) + ")");
+    }
+
     void flush() {
         if (!current_.has_segments) return;
         if (current_.closed)  // Z draws the closing segment: a repeated first point is dropped
@@ -435,6 +456,9 @@ class PathBuilder {
 
     OutputMap map_;
     double tol_;
+    std::size_t& curve_points_;
+    std::size_t max_curve_points_;
+    const Origin& origin_;
     Subpath current_;
     std::vector<Subpath> done_;
 };
@@ -468,8 +492,9 @@ std::size_t argument_count(char upper) {
 }
 
 std::vector<Subpath> parse_path_data(std::string_view d, const OutputMap& map, double tolerance,
+                                     std::size_t& curve_points, std::size_t max_curve_points,
                                      const Origin& origin) {
-    PathBuilder builder(map, tolerance);
+    PathBuilder builder(map, tolerance, curve_points, max_curve_points, origin);
     Scanner s(d);
     std::size_t group_start = 0;
     auto bad = [&](const std::string& why) {
@@ -693,12 +718,13 @@ class SvgReader {
     }
 
     std::vector<Subpath> shape_subpaths(const tinyxml2::XMLElement* e, std::string_view name,
-                                        const OutputMap& map, const Origin& origin) const {
+                                        const OutputMap& map, const Origin& origin) {
         auto num = [&](const char* attribute) {
             return number_attribute(e, attribute, 0.0, origin);
         };
         auto path = [&](const std::string& d) {
-            return parse_path_data(d, map, params_.flatten_tolerance, origin);
+            return parse_path_data(d, map, params_.flatten_tolerance, curve_points_,
+                                   params_.max_curve_points, origin);
         };
         auto fmt = [](double v) { return format_number(v); };
         if (name == "path") {
@@ -833,6 +859,7 @@ class SvgReader {
 
     const std::string& source_;
     const SvgReadParams& params_;
+    std::size_t curve_points_ = 0;  // vertices made by flattening so far
     std::vector<Layer> layers_;
     std::vector<Origin> origins_;
     bool any_outer_ = false;
@@ -909,6 +936,8 @@ void validate(const SvgReadParams& params) {
     if (!std::isfinite(params.flatten_tolerance) || params.flatten_tolerance <= 0.0)
         throw InvalidInput("parse_scene_svg: params.flatten_tolerance must be > 0 (got " +
                            format_number(params.flatten_tolerance) + ")");
+    if (params.max_curve_points < 1)
+        throw InvalidInput("parse_scene_svg: params.max_curve_points must be >= 1 (got 0)");
 }
 
 void validate(const SvgWriteParams& params) {

@@ -448,8 +448,36 @@ TEST_CASE("viewBox covers the scene and the underlay with a margin", "[io][svg]"
     CHECK_THAT(scene_to_svg(scene, params), Contains("viewBox=\"-11 -6 22 7\""));
 }
 
+TEST_CASE("curves that flatten to more vertices than max_curve_points are refused (fuzz_svg)",
+          "[io][svg]") {
+    // Two circles of radius 1000 at tolerance 1e-6: about 2 x 35,000 vertices.
+    const std::string body = R"~(<path id="big" d="M -1000 0 A 1000 1000 0 1 1 1000 0"/>
+<path id="twice" d="M -1000 0 A 1000 1000 0 1 1 1000 0 C 1000 2000 -1000 2000 -1000 0"/>)~";
+    SvgReadParams params;
+    params.flatten_tolerance = 1e-6;
+    const Scene all = parse_scene_svg(svg_doc(body), "test.svg", params);
+    const std::size_t made = all.vertex_count() - 4;  // the two movetos and the two arc ends
+    CHECK(made > 50000);
+    // The budget is the document's: exactly enough reads, one less is refused at the element
+    // that crosses it (the second path, line 3), naming the budget.
+    params.max_curve_points = made;
+    CHECK(parse_scene_svg(svg_doc(body), "test.svg", params).vertex_count() == all.vertex_count());
+    params.max_curve_points = made - 1;
+    CHECK_THROWS_WITH(parse_scene_svg(svg_doc(body), "test.svg", params),
+                      Contains("test.svg:3") && Contains("twice") &&
+                          Contains("more than " + std::to_string(made - 1) + " vertices"));
+    // A path at 1e57 (fuzz/regressions/svg): refused at the default budget, not read at 2^20
+    // vertices a curve until the memory runs out.
+    CHECK_THROWS_WITH(parse(R"~(<path id="far" d="m 5e57 50 a 3 2 10 1 0 4 4 c 1e57 0 0 1e57 1 1
+q 1e57 1e57 0 0 a 5e57 5e57 0 1 1 0 1"/>)~"),
+                      Contains("far") && Contains("flatten"));
+}
+
 TEST_CASE("params are validated", "[io][svg]") {
     SvgReadParams read;
+    read.max_curve_points = 0;
+    CHECK_THROWS_WITH(validate(read), Contains("max_curve_points"));
+    read = {};
     read.flatten_tolerance = 0.0;
     CHECK_THROWS_WITH(parse(R"~(<polyline points="0 0 1 1"/>)~", 0.0),
                       Contains("flatten_tolerance") && Contains("0"));

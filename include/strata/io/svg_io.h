@@ -25,6 +25,7 @@
 
 #include "strata/geometry/scene.h"
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -37,6 +38,11 @@ struct SvgReadParams {
     /// Largest distance between a curve (C/S/Q/T/A path commands) and its flattened
     /// polyline, in SVG user units (after transforms). > 0.
     double flatten_tolerance = 0.01;
+    /// Most vertices that flattening curves and arcs may make in the whole document (>= 1).
+    /// A document that needs more is refused with InvalidInput naming the element: curves
+    /// far larger than the tolerance (coordinates of 1e57 in a 700-byte file, found by
+    /// fuzz_svg) would otherwise fill the memory. Lines and listed points are not counted.
+    std::size_t max_curve_points = std::size_t{1} << 20;
 };
 
 /// Throws InvalidInput naming the first out-of-range field.
