@@ -213,12 +213,13 @@ std::optional<Vec2> body_centre(const Layer& layer) {
     return centre;
 }
 
-// The largest closed layer (bounding-box diagonal) with a body_centre() directly under layer
-// `b`; none if there is none.
+// The largest closed layer (bounding-box diagonal) with a body_centre() under layer `b`
+// (directly or with layers between them); none if there is none.
 std::optional<std::size_t> largest_body_under(const Scene& scene, std::size_t b) {
     std::optional<std::size_t> best;
     double best_size = -1.0;
-    for (std::size_t a : scene.inner_of(b)) {
+    for (std::size_t a = 0; a < scene.size(); ++a) {
+        if (scene.relation(a, b) != Relation::Under) continue;
         const Layer& inner = scene.layer(a);
         if (!inner.closed || !body_centre(inner)) continue;
         const Vec2 size = inner.bounds().size();
@@ -298,13 +299,17 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
             break;
         }
     }
-    // An open layer directly over a body that the rule above left to its vote (the largest
-    // closed layer directly under it, bounding-box diagonals, whose vertex centroid lies
-    // inside it), which it sweeps around by at least kSweep (the angle its vertices turn
-    // through seen from that centroid): outside away from the body. For a layer that runs
-    // back in part (a fold or a roll at its end, where the mean sine fails), whose vote
-    // counts the neighbours' vertices a tangle scattered. The largest: a small loop in a fold
-    // of the layer (a collar's cord) is swept around the other way.
+    // An open layer over a body that the rule above left to its vote (the largest closed
+    // layer under it, directly or with layers between them, bounding-box diagonals, whose
+    // vertex centroid lies inside it), which it sweeps around by at least kSweep (the angle
+    // its vertices turn through seen from that centroid): outside away from the body. For a
+    // layer that runs back in part (a fold or a roll at its end, where the mean sine fails),
+    // whose vote counts the neighbours' vertices a tangle scattered. The largest: a small loop
+    // in a fold of the layer (a collar's cord) is swept around the other way. With layers
+    // between: a jacket over a shirt over a body wraps the body as the shirt does, and a
+    // shirt's roll over the jacket's end (its vertices on the jacket's outside) scattered by a
+    // tangle turns the jacket's vote; the link of parallel layers below misses them when the
+    // roll lengthens the shirt (its tangents at the same fractions of their lengths part).
     constexpr double kSweep = 2.0 * 3.14159265358979323846 / 3.0;
     for (std::size_t b = 0; b < n; ++b) {
         if (scene.layer(b).closed || around[b]) continue;

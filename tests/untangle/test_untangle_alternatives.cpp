@@ -229,6 +229,29 @@ TEST_CASE("untangling_outside_sides: a collar folded at its end faces away from 
     CHECK(outvoted > 0);  // what the test is about: some decimation turns the vote
 }
 
+TEST_CASE("untangling_outside_sides: a jacket over a shirt over a body faces away from the body",
+          "[untangle][sides]") {
+    // The shirt rolled over the jacket's end, 95% removed at random: the tangle scatters the
+    // shirt's vertices over the jacket, and the roll (on the jacket's outside) lengthens the
+    // shirt so that the two layers' tangents at the same fractions of their lengths part (no
+    // parallel link). The jacket's vote can turn inside out. It sweeps around the body under
+    // the shirt (a layer between them) as the shirt does: its outside is away from the body.
+    const Scene input = make_scene(SceneFamily::ShirtRoll);
+    const std::vector<int> original = outside_sides(input);
+    REQUIRE(untangling_outside_sides(input) == original);
+    const std::size_t jacket = input.size() - 1;
+    REQUIRE(!input.layer(jacket).closed);
+    REQUIRE(input.inner_of(jacket).size() == 1);
+    REQUIRE(!input.layer(input.inner_of(jacket).front()).closed);  // the shirt between
+    std::size_t outvoted = 0;
+    for (unsigned seed = 1; seed <= 16; ++seed) {
+        const Scene tangled = naive_decimation(input, 0.95, seed);
+        if (outside_sides(tangled)[jacket] != original[jacket]) ++outvoted;
+        CHECK(untangling_outside_sides(tangled)[jacket] == original[jacket]);
+    }
+    CHECK(outvoted > 0);  // what the test is about: some decimation turns the vote
+}
+
 TEST_CASE("by_region with outside sides: a layer read wholly over the one above it is not a roll",
           "[untangle][sides]") {
     // Two open layers, `under` below `over`. Tangled, 7 of under's 9 inner vertices went across
