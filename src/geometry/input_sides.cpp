@@ -178,6 +178,43 @@ double diagonal(const Layer& layer) {
     return std::hypot(size.x, size.y);
 }
 
+// Where open `layer` turns back around an end of open layer `other` between two of its
+// regions (`regions`, in layer order; `s`: the recorded codes, `beyond_end` that of a vertex
+// closest to an end point of `other`): for each i such that between regions[i - 1] and
+// regions[i] lies a vertex closest to an end point of `other`
+// and the layer leaves regions[i - 1] travelling out past that end (its next segment runs the
+// way `other`'s end segment runs out) and enters regions[i] travelling back (its previous
+// segment runs the other way), the index i. A layer that goes around the end of another
+// without crossing it comes back on its other side: the regions between two such turns lie
+// on the other side from those between the turns before and after.
+std::vector<std::size_t> turns_around_end(const Layer& layer, const Layer& other,
+                                          const std::vector<signed char>& s,
+                                          const std::vector<Region>& regions,
+                                          signed char beyond_end) {
+    std::vector<std::size_t> out;
+    const std::vector<Vec2>& p = layer.points;
+    const std::vector<Vec2>& q = other.points;
+    if (layer.closed || other.closed || q.size() < 2) return out;
+    for (std::size_t i = 1; i < regions.size(); ++i) {
+        const std::size_t last = regions[i - 1].first + regions[i - 1].count - 1;
+        const std::size_t next = regions[i].first;
+        if (next <= last + 1 || next >= p.size()) continue;
+        std::size_t beyond = next;
+        for (std::size_t k = last + 1; k < next && beyond == next; ++k)
+            if (s[k] == beyond_end) beyond = k;
+        if (beyond == next) continue;
+        // The end of `other` that vertex is nearer to, and the way out past it.
+        const Vec2 v = p[beyond];
+        const bool at_last =
+            glm::dot(v - q.back(), v - q.back()) <= glm::dot(v - q.front(), v - q.front());
+        const Vec2 out_way = at_last ? q[q.size() - 1] - q[q.size() - 2] : q[0] - q[1];
+        if (glm::dot(p[last + 1] - p[last], out_way) > 0.0 &&
+            glm::dot(p[next] - p[next - 1], out_way) < 0.0)
+            out.push_back(i);
+    }
+    return out;
+}
+
 }  // namespace
 
 InputSides InputSides::by_region(const Scene& scene, const std::vector<int>& outside_sides) const {
@@ -211,7 +248,8 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                 continue;
             }
             const std::vector<signed char> recorded = s;
-            for (const Region& r : regions_of(layer, scene.layer(b), recorded)) {
+            const std::vector<Region> regions = regions_of(layer, scene.layer(b), recorded);
+            for (const Region& r : regions) {
                 signed char side = majority(r);
                 // A closed layer all of whose vertices form one region (a loop within reach
                 // of the other layer, e.g. a cord in a fold) and whose vertices disagree: the
@@ -284,7 +322,11 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
             // the global order's: not a roll (a roll is part of a layer, the rest on the global
             // order's side) but the two layers' order read inside out (a tangle that put most
             // of a layer across its neighbour). The global order's side.
-            if (!outside_sides.empty() && !layer.closed) {
+            // A closed layer larger than half the open one (no fold of it can hold the loop,
+            // as above): the same, its whole loop read on the other side is their order read
+            // inside out (a shirt's chord cut across the body it wraps).
+            const bool large = layer.closed && !small;
+            if (!outside_sides.empty() && (!layer.closed || large) && !scene.layer(b).closed) {
                 const int wanted = global_side(scene.relation(a, b), outside_sides[b]);
                 bool swapped = wanted != 0;
                 bool sided = false;
@@ -293,9 +335,28 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     sided = true;
                     swapped = swapped && c != wanted;
                 }
-                if (sided && swapped)
-                    for (signed char& c : s)
-                        if (c == 1 || c == -1) c = static_cast<signed char>(wanted);
+                if (sided && swapped) {
+                    // Unless the layer turns back around b's end between its regions
+                    // (turns_around_end()): then its parts between the turns lie on b's
+                    // sides in turn, and one of them at least is read wrong. The reading
+                    // that alternates with the most sided vertices on the global order's
+                    // side (a roll is part of a layer, the rest on that side); a tie: all on
+                    // the global order's side, as without a turn.
+                    const std::vector<std::size_t> turns =
+                        turns_around_end(layer, scene.layer(b), recorded, regions, kBeyondEnd);
+                    std::vector<int> part(n, -1);  // the part of each region's vertices
+                    std::size_t even = 0, odd = 0;
+                    for (std::size_t i = 0, p = 0; i < regions.size(); ++i) {
+                        while (p < turns.size() && turns[p] <= i) ++p;
+                        for (std::size_t c = 0; c < regions[i].count; ++c)
+                            part[(regions[i].first + c) % n] = static_cast<int>(p % 2);
+                        (p % 2 == 0 ? even : odd) += regions[i].count;
+                    }
+                    const int rolled = turns.empty() || even == odd ? -1 : (even > odd ? 1 : 0);
+                    for (std::size_t k = 0; k < n; ++k)
+                        if ((s[k] == 1 || s[k] == -1) && part[k] != rolled)
+                            s[k] = static_cast<signed char>(wanted);
+                }
             }
         }
     return codes;
