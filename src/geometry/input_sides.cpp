@@ -178,39 +178,27 @@ double diagonal(const Layer& layer) {
     return std::hypot(size.x, size.y);
 }
 
-// Where open `layer` turns back around an end of open layer `other` between two of its
-// regions (`regions`, in layer order; `s`: the recorded codes, `beyond_end` that of a vertex
-// closest to an end point of `other`): for each i such that between regions[i - 1] and
-// regions[i] lies a vertex closest to an end point of `other`
-// and the layer leaves regions[i - 1] travelling out past that end (its next segment runs the
-// way `other`'s end segment runs out) and enters regions[i] travelling back (its previous
-// segment runs the other way), the index i. A layer that goes around the end of another
-// without crossing it comes back on its other side: the regions between two such turns lie
-// on the other side from those between the turns before and after.
-std::vector<std::size_t> turns_around_end(const Layer& layer, const Layer& other,
-                                          const std::vector<signed char>& s,
-                                          const std::vector<Region>& regions,
-                                          signed char beyond_end) {
+// The vertices where open `layer` turns back around an end of open layer `other`: vertex k
+// within `within` of an end point of `other` (the one nearer to it), reached by a segment that
+// runs out past that end (the way `other`'s end segment runs out) and left by one that does
+// not. A layer that goes around the end of another without crossing it comes back on its
+// other side: its parts between such turns lie on the other's sides in turn (whether the
+// vertices around the bend are closest to the end point, or the decimation cut the bend
+// across the other layer).
+std::vector<std::size_t> turns_around_end(const Layer& layer, const Layer& other, double within) {
     std::vector<std::size_t> out;
     const std::vector<Vec2>& p = layer.points;
     const std::vector<Vec2>& q = other.points;
     if (layer.closed || other.closed || q.size() < 2) return out;
-    for (std::size_t i = 1; i < regions.size(); ++i) {
-        const std::size_t last = regions[i - 1].first + regions[i - 1].count - 1;
-        const std::size_t next = regions[i].first;
-        if (next <= last + 1 || next >= p.size()) continue;
-        std::size_t beyond = next;
-        for (std::size_t k = last + 1; k < next && beyond == next; ++k)
-            if (s[k] == beyond_end) beyond = k;
-        if (beyond == next) continue;
-        // The end of `other` that vertex is nearer to, and the way out past it.
-        const Vec2 v = p[beyond];
+    for (std::size_t k = 1; k + 1 < p.size(); ++k) {
+        const Vec2 v = p[k];
         const bool at_last =
             glm::dot(v - q.back(), v - q.back()) <= glm::dot(v - q.front(), v - q.front());
+        const Vec2 end = at_last ? q.back() : q.front();
+        if (glm::dot(v - end, v - end) > within * within) continue;
         const Vec2 out_way = at_last ? q[q.size() - 1] - q[q.size() - 2] : q[0] - q[1];
-        if (glm::dot(p[last + 1] - p[last], out_way) > 0.0 &&
-            glm::dot(p[next] - p[next - 1], out_way) < 0.0)
-            out.push_back(i);
+        if (glm::dot(p[k] - p[k - 1], out_way) > 0.0 && glm::dot(p[k + 1] - p[k], out_way) <= 0.0)
+            out.push_back(k);
     }
     return out;
 }
@@ -336,21 +324,21 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     swapped = swapped && c != wanted;
                 }
                 if (sided && swapped) {
-                    // Unless the layer turns back around b's end between its regions
-                    // (turns_around_end()): then its parts between the turns lie on b's
+                    // Unless the layer turns back around b's end (turns_around_end(), within
+                    // the reach of the sides): then its parts between the turns lie on b's
                     // sides in turn, and one of them at least is read wrong. The reading
-                    // that alternates with the most sided vertices on the global order's
-                    // side (a roll is part of a layer, the rest on that side); a tie: all on
-                    // the global order's side, as without a turn.
+                    // that alternates with more vertices recorded with a side on the global
+                    // order's side (a roll is part of a layer, the rest on that side); a tie:
+                    // all on the global order's side, as without a turn.
+                    if (near < 0.0) near = automatic_near_distance(scene);
                     const std::vector<std::size_t> turns =
-                        turns_around_end(layer, scene.layer(b), recorded, regions, kBeyondEnd);
-                    std::vector<int> part(n, -1);  // the part of each region's vertices
+                        turns_around_end(layer, scene.layer(b), detail::kSideReach * near);
+                    std::vector<int> part(n, 0);  // the number of turns before, modulo 2
                     std::size_t even = 0, odd = 0;
-                    for (std::size_t i = 0, p = 0; i < regions.size(); ++i) {
-                        while (p < turns.size() && turns[p] <= i) ++p;
-                        for (std::size_t c = 0; c < regions[i].count; ++c)
-                            part[(regions[i].first + c) % n] = static_cast<int>(p % 2);
-                        (p % 2 == 0 ? even : odd) += regions[i].count;
+                    for (std::size_t k = 0, t = 0; k < n; ++k) {
+                        while (t < turns.size() && turns[t] < k) ++t;
+                        part[k] = static_cast<int>(t % 2);
+                        if (recorded[k] == 1 || recorded[k] == -1) ++(t % 2 == 0 ? even : odd);
                     }
                     const int rolled = turns.empty() || even == odd ? -1 : (even > odd ? 1 : 0);
                     for (std::size_t k = 0; k < n; ++k)

@@ -335,6 +335,18 @@ TEST_CASE(
     CHECK(sides_of(recorded.by_region(tangled, outside), tangled, 0, 1) == "++++++++++00---");
     // Read from the untangled input, the roll is kept as it was (no part read wrong).
     CHECK(sides_of(original.by_region(input, outside), input, 0, 1) == "++++++++++00---");
+    // The decimation cut the bend across b (a chord from x = 9.5 under b to a bend vertex over
+    // it, short of b's end, then back): no vertex around b's end, one region, but the layer
+    // still turns back near b's end (out along b, then back): the same two parts.
+    std::vector<Layer> layers = tangled.layers();
+    std::vector<Vec2>& points = layers[0].points;
+    points.erase(points.begin() + 10, points.begin() + 12);
+    points.insert(points.begin() + 10, Vec2(9.8, 0.3));
+    const Scene bend_cut(layers);
+    REQUIRE(check_scene(bend_cut).crossing_count > 0);
+    const InputSides cut_sides = record_input_sides(bend_cut);
+    REQUIRE(sides_of(cut_sides, bend_cut, 0, 1) == "+--+--+--+----");
+    CHECK(sides_of(cut_sides.by_region(bend_cut, outside), bend_cut, 0, 1) == "+++++++++++---");
 }
 
 TEST_CASE(

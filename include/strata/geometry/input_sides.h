@@ -87,12 +87,13 @@ class InputSides {
     /// out on the other side than the global order's takes the global order's side of b: a
     /// roll is part of a layer, and a whole layer read over the one above it is their order
     /// read inside out. So does a closed layer larger than half b's size (no fold of b can
-    /// hold it: a body wrapped by b). Unless the open layer turns back around b's end between
-    /// two of its regions (a run of vertices closest to b's end point, entered travelling
-    /// out past that end and left travelling back): a layer that goes around b's end comes
-    /// back on b's other side, so its parts between such turns lie on b's sides in turn; of
-    /// the two readings that alternate, the one with more of the layer's region vertices on
-    /// the global order's side is kept (a tie: all on that side). Empty: no such rule. @throws
+    /// hold it: a body wrapped by b). Unless the open layer turns back around b's end (a
+    /// vertex within the reach of b's end point, reached travelling out past that end and
+    /// left travelling back, whether its bend is around the end or the decimation cut it
+    /// across b): a layer that goes around b's end comes back on b's other side, so its parts
+    /// between such turns lie on b's sides in turn; of the two readings that alternate, the
+    /// one with more of the vertices recorded with a side on the global order's side is kept
+    /// (a tie: all on that side). Empty: no such rule. @throws
     /// InvalidInput a scene or `outside_sides` of another layer count.
     InputSides by_region(const Scene& scene, const std::vector<int>& outside_sides = {}) const;
     /// Other readings of the sides by_region(scene) infers, for when the untangling by those
