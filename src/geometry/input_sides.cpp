@@ -179,12 +179,12 @@ double diagonal(const Layer& layer) {
 }
 
 // The vertices where open `layer` turns back around an end of open layer `other`: vertex k
-// within `within` of an end point of `other` (the one nearer to it), reached by a segment that
-// runs out past that end (the way `other`'s end segment runs out) and left by one that does
-// not. A layer that goes around the end of another without crossing it comes back on its
-// other side: its parts between such turns lie on the other's sides in turn (whether the
-// vertices around the bend are closest to the end point, or the decimation cut the bend
-// across the other layer).
+// within `within` of an end point of `other` (the one nearer to it) and nearest to that end's
+// segment of `other` (not to a fold of `other` near its end), reached by a segment that runs
+// out past that end (the way `other`'s end segment runs out) and left by one that does not. A layer
+// that goes around the end of another without crossing it comes back on its other side: its parts
+// between such turns lie on the other's sides in turn (whether the vertices around the bend are
+// closest to the end point, or the decimation cut the bend across the other layer).
 std::vector<std::size_t> turns_around_end(const Layer& layer, const Layer& other, double within) {
     std::vector<std::size_t> out;
     const std::vector<Vec2>& p = layer.points;
@@ -197,8 +197,25 @@ std::vector<std::size_t> turns_around_end(const Layer& layer, const Layer& other
         const Vec2 end = at_last ? q.back() : q.front();
         if (glm::dot(v - end, v - end) > within * within) continue;
         const Vec2 out_way = at_last ? q[q.size() - 1] - q[q.size() - 2] : q[0] - q[1];
-        if (glm::dot(p[k] - p[k - 1], out_way) > 0.0 && glm::dot(p[k + 1] - p[k], out_way) <= 0.0)
-            out.push_back(k);
+        if (!(glm::dot(p[k] - p[k - 1], out_way) > 0.0 &&
+              glm::dot(p[k + 1] - p[k], out_way) <= 0.0))
+            continue;
+        // Around that end, not a fold of both layers near it: the segment of `other` nearest
+        // to the vertex is its end segment.
+        std::size_t nearest = 0;
+        double best = -1.0;
+        for (std::size_t j = 0; j + 1 < q.size(); ++j) {
+            const Vec2 d = q[j + 1] - q[j];
+            const double len2 = glm::dot(d, d);
+            const double f = len2 > 0.0 ? std::clamp(glm::dot(v - q[j], d) / len2, 0.0, 1.0) : 0.0;
+            const Vec2 c = q[j] + f * d;
+            const double dist2 = glm::dot(v - c, v - c);
+            if (best < 0.0 || dist2 < best) {
+                best = dist2;
+                nearest = j;
+            }
+        }
+        if (nearest == (at_last ? q.size() - 2 : 0)) out.push_back(k);
     }
     return out;
 }
