@@ -323,6 +323,37 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     for (signed char& c : s)
                         if (c != kBeyondEnd) c = arms;
             }
+            // A region of an open layer read on the other side than the global order's, next
+            // to one on the global order's side with no turn around b's end (turns_around_end())
+            // in their span: the layer did not go around b to get there, so the reading is a
+            // tangle's (a chord of b cut across it), and the region takes the global order's
+            // side.
+            if (!outside_sides.empty() && !layer.closed && !scene.layer(b).closed &&
+                regions.size() > 1) {
+                const int wanted = global_side(scene.relation(a, b), outside_sides[b]);
+                if (near < 0.0) near = automatic_near_distance(scene);
+                const std::vector<std::size_t> turns =
+                    turns_around_end(layer, scene.layer(b), detail::kSideReach * near);
+                auto turn_in = [&](const Region& lo, const Region& hi) {
+                    for (const std::size_t k : turns)
+                        if (k >= lo.first && k < hi.first + hi.count) return true;
+                    return false;
+                };
+                std::vector<char> untangled(regions.size(), 0);
+                for (std::size_t i = 0; wanted != 0 && i < regions.size(); ++i) {
+                    if (s[regions[i].first] != -wanted) continue;
+                    const bool before = i > 0 && s[regions[i - 1].first] == wanted &&
+                                        !turn_in(regions[i - 1], regions[i]);
+                    const bool after = i + 1 < regions.size() &&
+                                       s[regions[i + 1].first] == wanted &&
+                                       !turn_in(regions[i], regions[i + 1]);
+                    untangled[i] = before || after;
+                }
+                for (std::size_t i = 0; i < regions.size(); ++i)
+                    if (untangled[i])
+                        for (std::size_t c = 0; c < regions[i].count; ++c)
+                            s[regions[i].first + c] = static_cast<signed char>(wanted);
+            }
             // An open layer all of whose vertices with a side are read on the other side than
             // the global order's: not a roll (a roll is part of a layer, the rest on the global
             // order's side) but the two layers' order read inside out (a tangle that put most

@@ -350,6 +350,33 @@ TEST_CASE(
 }
 
 TEST_CASE(
+    "by_region with outside sides: a region read over the other layer with no turn around "
+    "its end next to one under it is a tangle",
+    "[untangle][sides]") {
+    // b: a straight open layer along y = 0 from x = 0 to 10. a: under it (y < 0), but for
+    // three vertices over it (y > 0) between two far below (out of the sides' reach, as a
+    // chord of a decimated layer leaves them): three regions, the middle one read over b. The
+    // layer never goes around b's end, so it cannot lie over b there without crossing it: the
+    // middle region takes the global order's side. A roll, which turns back around b's end
+    // between its regions, keeps its side (the test above).
+    Layer a, b;
+    a.name = "a";
+    b.name = "b";
+    for (int k = 0; k <= 10; ++k) b.points.push_back(Vec2(k, 0.0));
+    for (int k = 0; k <= 12; ++k) {
+        const double y = (k == 4 || k == 8) ? -50.0 : (k >= 5 && k <= 7 ? 0.3 : -0.3);
+        a.points.push_back(Vec2(0.5 + 0.75 * k, y));
+    }
+    const Scene tangled({a, b});  // a under b
+    const InputSides recorded = record_input_sides(tangled);
+    REQUIRE(sides_of(recorded, tangled, 0, 1) == "++++0---0++++");
+    const std::vector<int> outside = {1, -1};  // b's outside: its left (y > 0)
+    REQUIRE(global_side(Relation::Under, outside[1]) == 1);
+    CHECK(sides_of(recorded.by_region(tangled), tangled, 0, 1) == "++++0---0++++");
+    CHECK(sides_of(recorded.by_region(tangled, outside), tangled, 0, 1) == "++++0+++0++++");
+}
+
+TEST_CASE(
     "by_region with outside sides: a body read wholly outside the layer that wraps it is "
     "not a roll",
     "[untangle][sides]") {

@@ -93,7 +93,10 @@ class InputSides {
     /// across b): a layer that goes around b's end comes back on b's other side, so its parts
     /// between such turns lie on b's sides in turn; of the two readings that alternate, the
     /// one with more of the vertices recorded with a side on the global order's side is kept
-    /// (a tie: all on that side). Empty: no such rule. @throws
+    /// (a tie: all on that side). And a region of an open layer read on the other side, next
+    /// to one on the global order's side with no such turn in their span, takes the global
+    /// order's side: the layer did not go around b to get there (a chord of b cut across it).
+    /// Empty: no such rule. @throws
     /// InvalidInput a scene or `outside_sides` of another layer count.
     InputSides by_region(const Scene& scene, const std::vector<int>& outside_sides = {}) const;
     /// Other readings of the sides by_region(scene) infers, for when the untangling by those
