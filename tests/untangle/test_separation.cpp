@@ -210,3 +210,40 @@ TEST_CASE("the finishing stage keeps nested loops nested", "[separation]") {
     finish(scene);
     test::require_collision_free(scene, 0.05);
 }
+
+TEST_CASE("the finishing stage takes an open layer's end back behind a vertex around it",
+          "[separation]") {
+    // The lower layer rolls around the upper one's end: its last vertex lay around that end
+    // in the input (any side of it), but the upper layer's end segment has come to reach 0.01
+    // past it, so its closest point there is inside the segment, on the upper side: the checks
+    // judge it by the global order (under), on the wrong side. The end moves back behind it.
+    const double t = 0.02;  // required separation 0.02
+    Scene scene(
+        {polyline("lower", {{0.0, 0.0}, {0.5, 0.0}, {1.0, 0.0}, {1.0, 0.2}, {0.69, 0.2}}, t),
+         polyline("upper", {{0.0, 0.1}, {0.35, 0.1}, {0.7, 0.1}}, t)});
+    const std::vector<Piece> pieces = whole_scene_pieces(scene);
+    detail::RelationSource relations;
+    relations.scene = &scene;
+    relations.local_sides.resize(2);
+    relations.local_sides[0].resize(5);
+    relations.local_sides[0][4].push_back({1, detail::RelationSource::Side::AnySide});
+    // The open layers' sides voted on the layers without the roll.
+    const std::vector<int> sides = outside_sides(
+        Scene({polyline("lower", {{0.0, 0.0}, {0.5, 0.0}, {1.0, 0.0}}, t), scene.layer(1)}));
+    detail::SeparationParams params;
+    params.outside_signs = &sides;
+    const Vec2 p = scene.layer(0).points[4];
+    auto past_end = [&] {  // how far the upper layer's end segment reaches past p
+        const std::vector<Vec2>& q = scene.layer(1).points;
+        const Vec2 e = q[2] - q[1];
+        return glm::dot(q[2] - scene.layer(0).points[4], e) / glm::length(e);
+    };
+    REQUIRE(past_end() == Approx(0.01));
+    // On the other side of the upper layer's end segment than the rest of the lower layer.
+    const Vec2 q1 = scene.layer(1).points[1], q2 = scene.layer(1).points[2];
+    REQUIRE(orient2d(q1, q2, p) == -orient2d(q1, q2, scene.layer(0).points[1]));
+    const detail::SeparationResult r = detail::finish_separations(scene, pieces, relations, params);
+    CHECK(r.moves > 0);
+    CHECK(past_end() <= -0.9 * t);  // the end is behind the vertex by about the aim
+    test::require_collision_free(scene, 0.1);
+}

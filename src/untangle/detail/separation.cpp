@@ -311,9 +311,10 @@ class Finisher {
             std::int32_t& slot = slot_[s.layer];
             if (slot < 0) {
                 slot = static_cast<std::int32_t>(nearest_.size());
-                nearest_.push_back({s.layer, i, d, false, 0, kNoTip});
+                nearest_.push_back({s.layer, i, d, false, 0, kNoTip, kNoTip});
             } else if (d < nearest_[static_cast<std::size_t>(slot)].distance) {
-                nearest_[static_cast<std::size_t>(slot)] = {s.layer, i, d, false, 0, kNoTip};
+                nearest_[static_cast<std::size_t>(slot)] = {s.layer, i,      d,     false,
+                                                            0,       kNoTip, kNoTip};
             }
         }
         for (Nearest& x : nearest_) {
@@ -330,8 +331,32 @@ class Finisher {
             x.is_wrong = wanted != 0 && x.distance < tangle_reach_ && interior(p, q0, q1) &&
                          orient2d(q0, q1, p) != wanted;
             x.tip = kNoTip;
+            x.end = kNoTip;
             if (!x.is_wrong && wanted != 0 && x.distance < tangle_reach_ && opens_cut_bends())
                 x.tip = hairpin_tip(s, p, wanted);
+            if (wanted == 0 && x.distance < tangle_reach_) x.end = slipped_end(l, v, s, p);
+        }
+        for (const Nearest& x : nearest_) {
+            if (x.end == kNoTip) continue;
+            // Around an end of layer m (any side), but m's end segment has come to reach past
+            // it, the vertex on the global order's wrong side of it: the end moves back behind
+            // the vertex's foot by the aim (or, when the end is fixed, the vertex moves out past
+            // it), so that the end is again the vertex's closest point on m.
+            const std::size_t m = x.layer, last = layer_size(m) - 1;
+            const std::size_t inner = x.end == 0 ? 1 : last - 1;
+            const Vec2 p = pts_[l][v], q = pts_[m][x.end], f = pts_[m][inner];
+            const double length = glm::distance(q, f);
+            const double aim = aim_[l * n + m];
+            ++wrong_side_;
+            worst_ = std::max(worst_, 1.0 + x.distance / aim);
+            if (!apply || !(length > 0.0)) continue;
+            const Vec2 u = (q - f) / length;  // out of m at the end
+            const double shift = length - glm::dot(p - f, u) + aim;
+            const double wp = inverse_mass_[l][v], wq = inverse_mass_[m][x.end];
+            if (wq > 0.0 && shift < 0.5 * length)
+                try_move(m, x.end, -shift * u, result, changed);
+            else if (wp > 0.0)
+                try_move(l, v, shift * u, result, changed);
         }
         const std::size_t moves_before = result.moves;
         for (const Nearest& x : nearest_) {
@@ -361,7 +386,7 @@ class Finisher {
             const SegId& s = found_[i];
             const std::size_t m = s.layer;
             const Nearest& near = nearest_[static_cast<std::size_t>(slot_[m])];
-            if (near.tip != kNoTip) continue;                // the hairpin's tip above
+            if (near.tip != kNoTip || near.end != kNoTip) continue;  // the tip, the end above
             if (near.is_wrong && near.index != i) continue;  // the tangle first
             const double aim = aim_[l * n + m];
             // Nothing moved yet in this call: the distance measured above is the one below.
@@ -440,6 +465,37 @@ class Finisher {
         return wanted == turn ? w : kNoTip;
     }
     static constexpr std::size_t kNoTip = static_cast<std::size_t>(-1);
+
+    // Vertex (l, v) at p takes any side of open layer m (it lies around m's end in the input:
+    // RelationSource::Side::AnySide), but segment s, its closest on m, is an end segment of m
+    // whose span holds p's foot, and p is on the other side of it than the global order asks
+    // for: p is no longer around the end, and the checks judge it by the global order (a
+    // vertex with no recorded side), so it is on the wrong side. Returns that end of m (0 or
+    // its last vertex), else kNoTip. Moves of m's end (pushed apart from another segment) make
+    // it so: the end turns and its segment comes to reach past p.
+    std::size_t slipped_end(std::size_t l, std::size_t v, const SegId& s, const Vec2& p) const {
+        const std::size_t m = s.layer, count = layer_size(m);
+        if (closed_[m] || count < 2 || params_.outside_signs == nullptr ||
+            m >= params_.outside_signs->size())
+            return kNoTip;
+        const Relation r = relation_[l * pts_.size() + m];
+        if (r == Relation::SideBySide || r == Relation::Same) return kNoTip;
+        if (relations_.side_of(l, v, m) != RelationSource::Side::AnySide) return kNoTip;
+        const std::size_t end = s.index == 0 ? 0 : s.index + 2 == count ? count - 1 : kNoTip;
+        if (end == kNoTip) return kNoTip;
+        const Vec2 q0 = cells_->start(s), q1 = cells_->end(s);
+        if (!interior(p, q0, q1)) return kNoTip;
+        // Just past: the foot within the aim of the end (deeper in, a tangle the projection
+        // takes out).
+        const Vec2 q = pts_[m][end], e = q - (end == 0 ? q1 : q0);
+        const double length = glm::length(e);
+        if (!(length > 0.0) || glm::dot(q - p, e) / length >= aim_[l * pts_.size() + m])
+            return kNoTip;
+        const int outside = (*params_.outside_signs)[m];
+        const int global = r == Relation::Under ? outside : -outside;
+        const int side = orient2d(q0, q1, p);
+        return side != 0 && side != global ? end : kNoTip;
+    }
 
     // The foot of p on segment (q0, q1) lies strictly inside it.
     static bool interior(const Vec2& p, const Vec2& q0, const Vec2& q1) {
@@ -638,6 +694,7 @@ class Finisher {
         bool is_wrong;
         int wanted;  // the side the vertex must be on (orient2d sign), 0: any
         std::size_t tip = static_cast<std::size_t>(-1);  // see hairpin_tip()
+        std::size_t end = static_cast<std::size_t>(-1);  // see slipped_end()
     };
     std::vector<Nearest> nearest_;
     std::vector<std::int32_t> slot_;  // per work layer: its entry in nearest_, -1: none
