@@ -62,6 +62,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"untangle_calls", r.untangle_calls},
                         {"refused", r.refused},
                         {"gave_up", r.gave_up},
+                        {"chord_shifts", r.chord_shifts},
                         {"deferred", r.deferred},
                         {"rounds", r.rounds},
                         {"batches", r.batches},

@@ -114,6 +114,7 @@ class SimplifyReport:
     untangle_calls: int
     refused: int
     gave_up: int
+    chord_shifts: int
     deferred: int
     batches: int
     targets_met: bool

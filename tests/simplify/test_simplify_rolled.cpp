@@ -373,8 +373,19 @@ TEST_CASE("sides matched without the correspondence keep a moved vertex on its o
         layer.points = std::move(points);
         return layer;
     };
-    const Layer a = open("a", {{0, 0}, {2, 0}, {4, 0}, {6, 0}, {8, 0}, {10, 0}, {11, 1}, {10, 2},
-                               {9, 2}, {8, 2}, {7, 2}, {6, 2}, {5, 2}});
+    const Layer a = open("a", {{0, 0},
+                               {2, 0},
+                               {4, 0},
+                               {6, 0},
+                               {8, 0},
+                               {10, 0},
+                               {11, 1},
+                               {10, 2},
+                               {9, 2},
+                               {8, 2},
+                               {7, 2},
+                               {6, 2},
+                               {5, 2}});
     const Layer b = open("b", {{-1, 1}, {1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1}});
     const Scene reference({a, b});
     const InputSides recorded = record_input_sides(reference);
@@ -399,10 +410,12 @@ TEST_CASE("sides matched without the correspondence keep a moved vertex on its o
 }
 
 TEST_CASE("an untangling of rolled vertices that stalls gives up (only there)", "[rolled]") {
-    // The shirt rolled over a jacket's end, random decimation at 90% (the default seed): one
-    // removal, the same in both scenes, cannot be untangled (a shirt chord cut into the body).
-    // Its job holds rolled vertices in the rolled scene only: there it gives up (from its
-    // fifth pass) instead of running all 16 passes; the counterpart's runs them as before.
+    // The shirt rolled over a jacket's end, random decimation, immediate schedule. In the
+    // rolled scene at 95% (seed 0) one removal cannot be untangled: its job holds rolled
+    // vertices and gives up (from its fifth pass) instead of running all 16 passes. In the
+    // counterpart at 90% (seed 1) one removal cannot be untangled either (a shirt chord cut
+    // into the body): its job holds no rolled vertex and runs them all. (The rolled scene at
+    // 90%, seed 1, keeps that removal: its chord is shifted out of the body, chord_shifts.)
     FamilyParams fp;
     fp.points = 3000;
     const Scene rolled = make_scene(SceneFamily::ShirtRoll, fp);
@@ -410,11 +423,12 @@ TEST_CASE("an untangling of rolled vertices that stalls gives up (only there)", 
     const Scene unrolled = make_scene(SceneFamily::ShirtRoll, fp);
     SimplifyParams params;
     params.decimator = "random";
-    params.remove = 0.9;
     params.schedule = UntangleSchedule::Immediate;
     for (int k = 0; k < 2; ++k) {
         INFO((k == 0 ? "rolled" : "unrolled"));
         Scene out = k == 0 ? rolled : unrolled;
+        params.remove = k == 0 ? 0.95 : 0.9;
+        params.seed = k == 0 ? 0 : 1;
         const SimplifyReport report = simplify(out, params);
         CHECK(report.collision_free);
         CHECK(report.targets_met);
@@ -423,6 +437,50 @@ TEST_CASE("an untangling of rolled vertices that stalls gives up (only there)", 
             CHECK(report.gave_up == report.refused);
             CHECK(report.rounds < 16 * static_cast<int>(report.refused));
         } else {
+            CHECK(report.gave_up == 0);
+            CHECK(report.chord_shifts == 0);  // no rolled job
+        }
+    }
+}
+
+TEST_CASE("a rolled removal whose chord cuts into the fold is kept by shifting the chord",
+          "[rolled]") {
+    // The collar folded around the cord (300 points, gap 2), random decimation at 95%, seed 8,
+    // immediate schedule: removals on the collar's turned-back part have chords that come
+    // closer to the cord in the fold than their separation. There is room for them where the
+    // collar was: moving a chord's two ends toward the removed vertex keeps its removal with
+    // no untangling pass (before, one of them was refused: its untangling gave up after five
+    // passes). Every shifted removal passed the job's exact check; the output is clean with
+    // the input's sides, on budget. The unrolled counterpart has no rolled job: nothing is
+    // shifted.
+    FamilyParams fp;
+    fp.points = 300;
+    fp.gap = 2.0;
+    for (const bool unrolled : {false, true}) {
+        INFO((unrolled ? "unrolled" : "rolled"));
+        fp.unrolled = unrolled;
+        const Scene input = make_scene(SceneFamily::CollarWrap, fp);
+        SimplifyParams params;
+        params.decimator = "random";
+        params.remove = 0.95;
+        params.seed = 8;
+        params.schedule = UntangleSchedule::Immediate;
+        Scene out = input;
+        const SimplifyReport report = simplify(out, params);
+        CHECK(report.collision_free);
+        CHECK(report.targets_met);
+        const std::vector<int> outside = outside_sides(input);
+        const InputSides out_sides = record_input_sides(input).renumbered(report.origins);
+        test::require_sides_kept(
+            test::check_with_sides(out, outside, params.untangling.separation_tolerance,
+                                   &out_sides),
+            0.9);
+        if (unrolled) {
+            CHECK(report.chord_shifts == 0);
+        } else {
+            CHECK(report.chord_shifts >= 1);
+            CHECK(report.chord_shifts <= report.untangle_calls);
+            CHECK(report.refused == 0);
             CHECK(report.gave_up == 0);
         }
     }

@@ -113,6 +113,10 @@ struct SimplifyReport {
     /// Of the refused removals, those whose untangling gave up before its last pass
     /// (UntangleParams::give_up_when_stalled).
     std::size_t gave_up = 0;
+    /// Of the untangle_calls, removals on a rolled part kept by moving the two ends of their
+    /// chord toward the removed vertex, out of what it cut into, without an untangling pass
+    /// (docs/simplify.md, *Rolled parts: shifting a chord*).
+    std::size_t chord_shifts = 0;
     std::size_t deferred = 0;        ///< Removals set aside (UntangleSchedule::Deferred).
     int rounds = 0;                  ///< Untangling rounds over all calls.
     /// Untanglings of a batch run once more alone, because their vertices came within reach

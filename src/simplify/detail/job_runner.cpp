@@ -1,5 +1,7 @@
 #include "simplify/detail/job_runner.h"
 
+#include "strata/geometry/predicates.h"
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -213,6 +215,7 @@ void JobRunner::local_sides(Job& job) const {
         for (const auto& vertex : layer)
             for (const RelationSource::LocalSide& x : vertex)
                 if (x.side == RelationSource::Side::Flipped) {
+                    job.rolled = true;
                     job.settings.give_up_when_stalled = true;
                     job.settings.finish_stop_when_wrong_stays = 1;
                 }
@@ -263,8 +266,116 @@ void JobRunner::execute(Job& job) const {
         // Sides of the open layers, as the input gives them (a rolled part stays rolled).
         return check_.sides_kept(ov);
     };
+    job.shifted = job.rolled && shift_chord(job, is_ok);
+    if (job.shifted) {
+        job.result = EngineResult{};
+        job.result.ok = true;
+        return;
+    }
     job.result = run_engine(*job.work, job.pieces, params_.untangling, job.relations, job.settings,
                             is_ok, {});
+}
+
+// A removal whose chord (a, b) crosses nothing but comes closer than their separation to other
+// layers, all of them on the far side of it from the removed vertex (the chord of a bend cuts
+// into what lies inside the bend): moving a and b together toward the removed vertex, along
+// the chord's normal, gives the room back where the layer was. Shifts tried: to the required
+// separation, to the checked one (need), twice those; never beyond the removed vertex's
+// distance to the chord. One is kept when no vertex lies in the area that (before a, a),
+// (a, b) and (b, after b) sweep (so nothing tunnels: that area's old sides are live segments
+// and the crossing-free chord) and `is_ok` (the job's exact check) passes; the work scene is
+// left as it was otherwise. Tried for rolled jobs only (Job::rolled), before the untangling:
+// there the untangling of such a removal moved the whole fold and gave up (collar_wrap,
+// docs/simplify.md); other jobs run as before, so scenes without rolls keep their outputs.
+bool JobRunner::shift_chord(Job& job, const std::function<bool(const Scene&)>& is_ok) const {
+    const std::size_t l = job.l, a = job.a, b = job.b;
+    const WorkLayer& w = live_.layer(l);
+    if (!slots_.is_free(l, a, job) || !slots_.is_free(l, b, job)) return false;
+    const std::size_t before_a = w.prev[a], after_b = w.next[b];
+    if (before_a == kNone || after_b == kNone) return false;
+    const Vec2 pa = w.pos[a], pb = w.pos[b], v = job.removed;
+    const int side = orient2d(pa, pb, v);
+    const double length = glm::distance(pa, pb);
+    if (side == 0 || !(length > 0.0)) return false;
+    Vec2 normal(pb.y - pa.y, pa.x - pb.x);  // right of a -> b
+    normal /= length;
+    if (glm::dot(normal, v - pa) < 0.0) normal = -normal;  // toward the removed vertex
+    const double height = glm::dot(normal, v - pa);
+    Box2 chord;
+    chord.extend(pa);
+    chord.extend(pb);
+    // The check passes a gap at need (the required separation less the tolerance); the shift
+    // aims at the required separation itself, as the finishing stage does.
+    const double full = 1.0 / (1.0 - params_.untangling.separation_tolerance);
+    double shortfall = 0.0, least = 0.0;  // to the required separation, to need
+    bool blocked = false;
+    live_.live_segments_near(
+        chord.inflated(full * separations_.reach[l]), [&](const LiveSegment& s) {
+            if (blocked || s.layer == l) return;
+            const double need = separations_.need[l][s.layer];
+            if (!(need > 0.0)) return;
+            if (segment_contact(pa, pb, s.p, s.q) != SegmentContact::None) {
+                blocked = true;
+                return;
+            }
+            const double d = std::min(
+                std::min(point_segment_distance(s.p, pa, pb), point_segment_distance(s.q, pa, pb)),
+                std::min(point_segment_distance(pa, s.p, s.q),
+                         point_segment_distance(pb, s.p, s.q)));
+            if (!(d < full * need)) return;
+            if (orient2d(pa, pb, s.p) == side || orient2d(pa, pb, s.q) == side) {
+                blocked = true;  // on the removed vertex's side: moving toward it cannot help
+                return;
+            }
+            shortfall = std::max(shortfall, full * need - d);
+            least = std::max(least, need - d);
+        });
+    if (blocked || !(shortfall > 0.0)) return false;
+    const std::size_t ra = slots_.run[l][a], ka = slots_.index[l][a];
+    const std::size_t rb = slots_.run[l][b], kb = slots_.index[l][b];
+    Scene& work = *job.work;
+    const Vec2 before = w.pos[before_a], after = w.pos[after_b];
+    // The shift to the required separation first, then to need, then twice those (a shift
+    // also moves the neighbouring segments): the first that the check passes.
+    for (const double by : {shortfall, least, 2.0 * least, 2.0 * shortfall}) {
+        if (!(by > 0.0) || by > height) continue;
+        const Vec2 qa = pa + by * normal, qb = pb + by * normal;
+        // Nothing in the area swept by (before, a), (a, b) and (b, after).
+        Box2 swept;
+        for (const Vec2& p : {before, pa, pb, after, qa, qb}) swept.extend(p);
+        bool clear = true;
+        auto in = [](const Vec2& x, const Vec2& p, const Vec2& q, const Vec2& r) {
+            Box2 box;  // exact, and what decides for a flat triangle
+            box.extend(p);
+            box.extend(q);
+            box.extend(r);
+            if (!box.contains(x)) return false;
+            const int o1 = orient2d(p, q, x), o2 = orient2d(q, r, x), o3 = orient2d(r, p, x);
+            return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+        };
+        live_.live_segments_near(swept, [&](const LiveSegment& s) {
+            if (!clear) return;
+            for (const std::size_t x : {std::size_t{s.start}, std::size_t{s.end}}) {
+                if (s.layer == l && (x == before_a || x == a || x == b || x == after_b)) continue;
+                const Vec2 p = x == s.start ? s.p : s.q;
+                if (in(p, before, pa, qa) || in(p, pa, qa, qb) || in(p, pa, qb, pb) ||
+                    in(p, pb, qb, after))
+                    clear = false;
+            }
+        });
+        if (!clear) continue;
+        auto set = [&](std::size_t r, std::size_t k, const Vec2& to) {
+            std::vector<Vec2> points = work.layer(r).points;
+            points[k] = to;
+            work.set_points(r, std::move(points));
+        };
+        set(ra, ka, qa);
+        set(rb, kb, qb);
+        if (is_ok(work)) return true;
+        set(ra, ka, pa);
+        set(rb, kb, pb);
+    }
+    return false;
 }
 
 void JobRunner::apply(const Job& job) {

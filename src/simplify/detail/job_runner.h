@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace strata::detail {
@@ -44,6 +45,10 @@ class JobRunner {
 
   private:
     void local_sides(Job& job) const;
+    /// Keeps the removal of a rolled job by moving its chord's two ends toward the removed
+    /// vertex, out of the layers the chord came too close to, when `is_ok` passes: true, the
+    /// work scene moved; false, it is as it was.
+    bool shift_chord(Job& job, const std::function<bool(const Scene&)>& is_ok) const;
     void mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked,
               const std::vector<Job>& waiting);
     bool is_marked(std::size_t k, std::size_t v) const {

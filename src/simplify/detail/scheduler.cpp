@@ -205,6 +205,7 @@ bool Scheduler::commit(const Job& job) {
     report_.seconds_finish += job.result.seconds_finish;
     report_.seconds_check += job.result.seconds_check;
     if (job.result.gave_up) ++report_.gave_up;
+    if (job.shifted) ++report_.chord_shifts;
     if (!job.result.ok) return false;
     jobs_.apply(job);
     // New costs around the removal and the moved vertices.

@@ -37,6 +37,8 @@ struct Job {
     Box2 footprint;              ///< The runs' vertices before, and the removed one.
     EngineResult result;
     double seconds_prepare = 0.0;
+    bool rolled = false;   ///< Some vertex of the job takes an open layer Flipped (a roll).
+    bool shifted = false;  ///< Kept by shifting its chord (JobRunner::shift_chord()), no pass.
 };
 
 /// The job for removing vertex v of layer l, still linked.
