@@ -116,7 +116,10 @@ Run add_untangle_command(CLI::App& app) {
         check_params.input_sides = params.input_sides;
         Scene scene = input;
         const auto start = std::chrono::steady_clock::now();
-        const bool fallback = !params.input_sides && !opt->global_order;
+        // Without an original, or with one (whose sides are not in question: long rounds when
+        // the first tries fail), the tries of untangle_inferring_sides(); --global-order and
+        // --infer-sides: one untangle().
+        const bool fallback = !opt->global_order && !opt->infer_sides;
         const UntangleReport r =
             fallback ? untangle_inferring_sides(scene, params, terminal_progress(), &inferred)
                      : untangle(scene, params, terminal_progress());

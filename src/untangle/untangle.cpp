@@ -435,15 +435,18 @@ bool has_rolled_regions(const Scene& scene) {
 }
 
 // When the tries with params fail, they run again with long rounds (UntangleParams::
-// long_rounds_factor) and the first clean result is kept; the report counts both. Only for a
-// scene without rolled regions: where the sides are in question, longer rounds let a wrong
-// reading hold (the collar at 95%, seeds 4 and 9, came out clean by the global order with its
-// fold unrolled), and the untangling had better say it failed.
+// long_rounds_factor) and the first clean result is kept; the report counts both. Only where
+// the sides are known (`sides_known`: an original's) or the scene has no rolled regions: where
+// the sides are in question, longer rounds let a wrong reading hold (the collar at 95%, seeds 4
+// and 9, came out clean by the global order with its fold unrolled), and the untangling had
+// better say it failed.
 template <class Tries>
-UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, Tries&& tries) {
+UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, bool sides_known,
+                                Tries&& tries) {
     const Scene input = scene;
     UntangleReport report = tries(scene, params);
-    if (report.collision_free || params.long_rounds_factor <= 1 || has_rolled_regions(input))
+    if (report.collision_free || params.long_rounds_factor <= 1 ||
+        (!sides_known && has_rolled_regions(input)))
         return report;
     UntangleParams longer = params;
     longer.gradient_steps = params.gradient_steps * params.long_rounds_factor;
@@ -573,8 +576,10 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
                                         const ProgressFn& progress, InputSides* kept) {
     if (params.input_sides && !params.input_sides->empty())
-        return untangle(scene, params, progress);
-    return with_long_rounds(scene, params, [&](Scene& s, const UntangleParams& p) {
+        return with_long_rounds(scene, params, true, [&](Scene& s, const UntangleParams& p) {
+            return untangle_tries(s, p, progress);
+        });
+    return with_long_rounds(scene, params, false, [&](Scene& s, const UntangleParams& p) {
         return inferring_sides_tries(s, p, progress, kept);
     });
 }

@@ -74,3 +74,34 @@ TEST_CASE("untangle() itself does not retry with longer rounds", "[untangle]") {
     CHECK_FALSE(report.collision_free);
     CHECK_FALSE(report.long_rounds);
 }
+
+TEST_CASE("untangle_inferring_sides: with the original's sides, longer rounds when the tries fail",
+          "[untangle]") {
+    // The folded stack at 95%, seed 3, with the sides of the original (what `strata untangle
+    // --reference` gives): not in question, so a failed try runs again with longer rounds, as
+    // without an original; untangle() alone stays tangled.
+    FamilyParams p;
+    p.layers = 4;
+    const Scene input = make_scene(SceneFamily::Folded, p);
+    const Scene tangled = naive_decimation(input, 0.95, 3);
+    const InputSides sides = InputSides::matched(record_input_sides(input), input, tangled);
+    UntangleParams params;
+    params.outside_sides = outside_sides(input);
+    params.input_sides = &sides;
+    Scene once = tangled;
+    const UntangleReport first = untangle(once, params);
+    CHECK_FALSE(first.collision_free);
+    Scene out = tangled;
+    const UntangleReport report = untangle_inferring_sides(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.long_rounds);
+    CHECK(report.passes > first.passes);
+    CheckParams judged;
+    judged.outside_sides = params.outside_sides;
+    judged.input_sides = &sides;
+    judged.separation_tolerance = 0.1;
+    const CheckReport c = check_scene(out, judged);
+    CHECK(c.is_collision_free());
+    CHECK(c.separations_hold());
+    CHECK(c.nesting_violation_count == 0);
+}

@@ -215,7 +215,8 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// other side), first as untangle()'s first try, then as its second; the first round with a clean
 /// result keeps the clean one that moves a vertex least (report.inferred_sides, `kept` those
 /// sides). When every try fails, they all run once more with params.long_rounds_factor times the
-/// gradient steps (report.long_rounds). With params.input_sides given, this is untangle(). Same
+/// gradient steps (report.long_rounds). With params.input_sides given (an original's sides, not
+/// in question), untangle(), and when it fails once more with the long rounds. Same
 /// params, progress and throws as untangle(). `kept`: if given, receives the inferred sides when
 /// they were kept, for judging the result (check_scene() with them and params' outside sides, or
 /// outside_sides() of the input); left alone otherwise.
