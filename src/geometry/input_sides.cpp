@@ -106,6 +106,29 @@ signed char majority(const Region& r) {
     return static_cast<signed char>(r.plus > r.minus ? 1 : (r.plus < r.minus ? -1 : 0));
 }
 
+// The segment of polyline q (>= 2 points) closest to p, and the parameter of the closest point
+// on it (0 at q[segment], 1 at q[segment + 1]); the first of equals.
+struct ClosestSegment {
+    std::size_t segment = 0;
+    double at = 0.0;
+};
+ClosestSegment closest_segment(const std::vector<Vec2>& q, const Vec2& p) {
+    ClosestSegment out;
+    double best = -1.0;
+    for (std::size_t j = 0; j + 1 < q.size(); ++j) {
+        const Vec2 d = q[j + 1] - q[j];
+        const double len2 = glm::dot(d, d);
+        const double t = len2 > 0.0 ? std::clamp(glm::dot(p - q[j], d) / len2, 0.0, 1.0) : 0.0;
+        const Vec2 c = q[j] + t * d;
+        const double dist2 = glm::dot(p - c, p - c);
+        if (best < 0.0 || dist2 < best) {
+            best = dist2;
+            out = {j, t};
+        }
+    }
+    return out;
+}
+
 // The side of open layer `other` that the centroid of closed `layer`'s vertices lies on, by
 // the rule of record_input_sides() (the side at the closest point; at a corner, the side of
 // the corner's wedge); 0 when the closest point is an end point of `other`.
@@ -114,22 +137,9 @@ signed char centroid_side(const Layer& layer, const Layer& other) {
     for (const Vec2& p : layer.points) centre += p;
     centre /= static_cast<double>(layer.points.size());
     const std::vector<Vec2>& q = other.points;
-    double best = -1.0, at = 0.0;
-    std::size_t segment = 0;
-    for (std::size_t j = 0; j + 1 < q.size(); ++j) {
-        const Vec2 d = q[j + 1] - q[j];
-        const double len2 = glm::dot(d, d);
-        const double t = len2 > 0.0 ? std::clamp(glm::dot(centre - q[j], d) / len2, 0.0, 1.0) : 0.0;
-        const Vec2 c = q[j] + t * d;
-        const double dist2 = glm::dot(centre - c, centre - c);
-        if (best < 0.0 || dist2 < best) {
-            best = dist2;
-            segment = j;
-            at = t;
-        }
-    }
-    if (best < 0.0 || (segment == 0 && at <= 0.0) || (segment + 2 == q.size() && at >= 1.0))
-        return 0;
+    if (q.size() < 2) return 0;
+    const auto [segment, at] = closest_segment(q, centre);
+    if ((segment == 0 && at <= 0.0) || (segment + 2 == q.size() && at >= 1.0)) return 0;
     int side = 0;
     if (at >= 1.0)
         side = corner_side(q[segment], q[segment + 1], q[segment + 2], centre);
@@ -202,20 +212,7 @@ std::vector<std::size_t> turns_around_end(const Layer& layer, const Layer& other
             continue;
         // Around that end, not a fold of both layers near it: the segment of `other` nearest
         // to the vertex is its end segment.
-        std::size_t nearest = 0;
-        double best = -1.0;
-        for (std::size_t j = 0; j + 1 < q.size(); ++j) {
-            const Vec2 d = q[j + 1] - q[j];
-            const double len2 = glm::dot(d, d);
-            const double f = len2 > 0.0 ? std::clamp(glm::dot(v - q[j], d) / len2, 0.0, 1.0) : 0.0;
-            const Vec2 c = q[j] + f * d;
-            const double dist2 = glm::dot(v - c, v - c);
-            if (best < 0.0 || dist2 < best) {
-                best = dist2;
-                nearest = j;
-            }
-        }
-        if (nearest == (at_last ? q.size() - 2 : 0)) out.push_back(k);
+        if (closest_segment(q, v).segment == (at_last ? q.size() - 2 : 0)) out.push_back(k);
     }
     return out;
 }
