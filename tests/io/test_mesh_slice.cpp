@@ -403,6 +403,23 @@ TEST_CASE("malformed PLY and OFF files are refused with line and column or byte 
     binary.replace(binary.size() - 36, 36, reinterpret_cast<const char*>(corners), 36);
     binary.append(reinterpret_cast<const char*>(face), 16);
     CHECK(read_slice_mesh(write("fits_binary.ply", binary)).triangles.size() == 1);
+    // OFF variants: [ST][C][N]OFF, what follows a vertex's position (texture coordinates,
+    // colour, normal) skipped; other keywords refused.
+    for (const std::string magic : {"COFF", "NOFF", "STOFF", "CNOFF", "STCNOFF"}) {
+        CAPTURE(magic);
+        std::string extra;
+        if (magic.find("ST") == 0) extra += " 0.5 0.5";
+        if (magic.find('C') != std::string::npos) extra += " 1 0 0 1";
+        if (magic.find('N') != std::string::npos) extra += " 0 0 1";
+        std::string text = magic + "\n3 1 0\n";
+        for (const char* v : {"0 0 0", "1 0 1", "0 1 1"}) text += v + extra + "\n";
+        text += "3 0 1 2\n";
+        CHECK(read_slice_mesh(write("variant.off", text)).triangles.size() == 1);
+    }
+    for (const std::string magic : {"SOFF", "OFFS", "NCOFF", "TOFF"})
+        CHECK_THROWS_WITH(read_slice_mesh(write("variant.off", magic + "\n3 1 0\n0 0 0\n1 0 1\n"
+                                                                       "0 1 1\n3 0 1 2\n")),
+                          Contains("not an OFF header"));
     // A valid header still reads (CRLF line ends and comments included).
     const SliceMesh ok = read_slice_mesh(
         write("ok.ply", "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\n" + body));

@@ -11,10 +11,10 @@
 #include <cstdlib>
 #include <fstream>
 #include <locale>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace strata::detail {
@@ -343,6 +343,13 @@ void validate_ply_body(const std::filesystem::path& path, std::istream& in,
             }
 }
 
+// An OFF header keyword: [ST][C][N][4][n]OFF, each prefix optional, in that order.
+bool is_off_magic(std::string_view magic) {
+    for (std::string_view prefix : {"ST", "C", "N", "4", "n"})
+        if (magic.substr(0, prefix.size()) == prefix) magic.remove_prefix(prefix.size());
+    return magic == "OFF";
+}
+
 }  // namespace
 
 OffMesh read_off_text(const std::filesystem::path& path) {
@@ -355,8 +362,7 @@ OffMesh read_off_text(const std::filesystem::path& path) {
             tokens.push_back(std::move(t));
     if (tokens.empty()) mesh_text_error(path, {"", 1, 1}, "empty file: expected an OFF header");
     const std::string& magic = tokens[0].text;
-    static const std::regex variant("(ST)?C?N?4?n?OFF");
-    if (!std::regex_match(magic, variant))
+    if (!is_off_magic(magic))
         mesh_text_error(path, tokens[0],
                         "not an OFF header (got '" + shown_token(magic) +
                             "'; expected OFF, COFF, NOFF, STOFF ...)");
