@@ -275,10 +275,14 @@ void validate_ply_body(const std::filesystem::path& path, std::istream& in,
         std::string line;
         std::vector<TextToken> tokens;
         std::size_t line_number = layout.header_lines, next = 0;
-        auto take = [&](const std::string& at) -> const TextToken& {
+        // The next token, of property p of element e's k-th item (named only on error: this
+        // runs once per value of the file).
+        auto take = [&](const PlyElement& e, long long k,
+                        const PlyProperty& p) -> const TextToken& {
             while (next == tokens.size()) {
                 if (!std::getline(in, line))
-                    mesh_text_error(path, {"", line_number + 1, 1}, what_ends + at + ")");
+                    mesh_text_error(path, {"", line_number + 1, 1},
+                                    what_ends + where(e, k, p) + ")");
                 tokens = line_tokens(line, ++line_number);
                 next = 0;
             }
@@ -288,10 +292,10 @@ void validate_ply_body(const std::filesystem::path& path, std::istream& in,
             for (long long k = 0; k < e.count; ++k)
                 for (const PlyProperty& p : e.properties) {
                     if (!p.list) {
-                        take(where(e, k, p));
+                        take(e, k, p);
                         continue;
                     }
-                    const TextToken& t = take(where(e, k, p));
+                    const TextToken& t = take(e, k, p);
                     const long long length = integer_token(path, t, t.text, "a list length");
                     if (length < 0)
                         mesh_text_error(path, t, "list length is negative (got '" + t.text + "')");
@@ -302,7 +306,7 @@ void validate_ply_body(const std::filesystem::path& path, std::istream& in,
                                             "list length " + at.text +
                                                 " is more than the file holds (" + where(e, k, p) +
                                                 ")");
-                        take(where(e, k, p));
+                        take(e, k, p);
                     }
                 }
         return;
