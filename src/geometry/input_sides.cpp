@@ -251,6 +251,16 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
             }
             const std::vector<signed char> recorded = s;
             const std::vector<Region> regions = regions_of(layer, scene.layer(b), recorded);
+            // turns_around_end() of the layer around b's ends, when first needed (by both rules
+            // below).
+            std::optional<std::vector<std::size_t>> turns;
+            auto turns_of = [&]() -> const std::vector<std::size_t>& {
+                if (!turns) {
+                    if (near < 0.0) near = automatic_near_distance(scene);
+                    turns = turns_around_end(layer, scene.layer(b), detail::kSideReach * near);
+                }
+                return *turns;
+            };
             for (const Region& r : regions) {
                 signed char side = majority(r);
                 // A closed layer all of whose vertices form one region (a loop within reach
@@ -328,11 +338,8 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
             if (!outside_sides.empty() && !layer.closed && !scene.layer(b).closed &&
                 regions.size() > 1) {
                 const int wanted = global_side(scene.relation(a, b), outside_sides[b]);
-                if (near < 0.0) near = automatic_near_distance(scene);
-                const std::vector<std::size_t> turns =
-                    turns_around_end(layer, scene.layer(b), detail::kSideReach * near);
                 auto turn_in = [&](const Region& lo, const Region& hi) {
-                    for (const std::size_t k : turns)
+                    for (const std::size_t k : turns_of())
                         if (k >= lo.first && k < hi.first + hi.count) return true;
                     return false;
                 };
@@ -375,17 +382,15 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     // that alternates with more vertices recorded with a side on the global
                     // order's side (a roll is part of a layer, the rest on that side); a tie:
                     // all on the global order's side, as without a turn.
-                    if (near < 0.0) near = automatic_near_distance(scene);
-                    const std::vector<std::size_t> turns =
-                        turns_around_end(layer, scene.layer(b), detail::kSideReach * near);
+                    const std::vector<std::size_t>& turn = turns_of();
                     std::vector<int> part(n, 0);  // the number of turns before, modulo 2
                     std::size_t even = 0, odd = 0;
                     for (std::size_t k = 0, t = 0; k < n; ++k) {
-                        while (t < turns.size() && turns[t] < k) ++t;
+                        while (t < turn.size() && turn[t] < k) ++t;
                         part[k] = static_cast<int>(t % 2);
                         if (recorded[k] == 1 || recorded[k] == -1) ++(t % 2 == 0 ? even : odd);
                     }
-                    const int rolled = turns.empty() || even == odd ? -1 : (even > odd ? 1 : 0);
+                    const int rolled = turn.empty() || even == odd ? -1 : (even > odd ? 1 : 0);
                     for (std::size_t k = 0; k < n; ++k)
                         if ((s[k] == 1 || s[k] == -1) && part[k] != rolled)
                             s[k] = static_cast<signed char>(wanted);
