@@ -14,14 +14,23 @@
 using namespace strata;
 using test::naive_decimation;
 
+namespace {
+
+// The benchmark's folded stack (4 layers of 300 points).
+Scene folded_stack() {
+    FamilyParams p;
+    p.layers = 4;
+    return make_scene(SceneFamily::Folded, p);
+}
+
+}  // namespace
+
 TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded stack at 95%)",
           "[untangle]") {
     // The benchmark's folded stack (4 layers of 300 points), 95% removed at random, seed 3
     // (unseen by the benchmark, whose seed is 1): every try wanders for 64 passes and ends
     // tangled with 10 steps a round; with 30 they come out clean.
-    FamilyParams p;
-    p.layers = 4;
-    const Scene input = make_scene(SceneFamily::Folded, p);
+    const Scene input = folded_stack();
     CheckParams judged;
     judged.outside_sides = outside_sides(input);
     judged.separation_tolerance = 0.1;
@@ -66,9 +75,7 @@ TEST_CASE("untangle_inferring_sides: a scene the first try cleans gets no longer
 }
 
 TEST_CASE("untangle() itself does not retry with longer rounds", "[untangle]") {
-    FamilyParams p;
-    p.layers = 4;
-    const Scene tangled = naive_decimation(make_scene(SceneFamily::Folded, p), 0.95, 3);
+    const Scene tangled = naive_decimation(folded_stack(), 0.95, 3);
     Scene out = tangled;
     const UntangleReport report = untangle(out, UntangleParams{});
     CHECK_FALSE(report.collision_free);
@@ -80,9 +87,7 @@ TEST_CASE("untangle_inferring_sides: with the original's sides, longer rounds wh
     // The folded stack at 95%, seed 3, with the sides of the original (what `strata untangle
     // --reference` gives): not in question, so a failed try runs again with longer rounds, as
     // without an original; untangle() alone stays tangled.
-    FamilyParams p;
-    p.layers = 4;
-    const Scene input = make_scene(SceneFamily::Folded, p);
+    const Scene input = folded_stack();
     const Scene tangled = naive_decimation(input, 0.95, 3);
     const InputSides sides = InputSides::matched(record_input_sides(input), input, tangled);
     UntangleParams params;
