@@ -211,7 +211,8 @@ Run add_untangle_command(CLI::App& app) {
                 const Crossing& c = after.self_crossings.front();
                 const Layer& layer = scene.layer(c.layer_a);
                 why = layer.closed && is_flat(layer.points)
-                          ? "; layer '" + layer.name + "' is flat: all its points are collinear"
+                          ? "; layer '" + shown_text(layer.name) +
+                                "' is flat: all its points are collinear"
                           : "; layer '" + layer.name + "' crosses itself (segments " +
                                 std::to_string(c.segment_a) + " and " +
                                 std::to_string(c.segment_b) + " at (" + format_number(c.point.x) +

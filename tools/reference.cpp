@@ -3,6 +3,7 @@
 #include "cli_util.h"
 
 #include "strata/core/error.h"
+#include "strata/core/format.h"
 #include "strata/geometry/checks.h"
 #include "strata/io/scene_io.h"
 
@@ -32,7 +33,7 @@ Reference match_reference(Scene original, const Scene& scene, double near_distan
         } else {
             ++missing_count;
             if (missing_count <= 5)
-                missing += (missing.empty() ? "'" : ", '") + scene.layer(i).name + "'";
+                missing += (missing.empty() ? "'" : ", '") + shown_text(scene.layer(i).name) + "'";
         }
         // An open layer decimated to a few vertices gets its side from its original.
         ref.outside_sides.push_back(j && !ref.scene.layer(*j).closed

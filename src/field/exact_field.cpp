@@ -6,6 +6,7 @@
 #include "field/detail/segment_index.h"
 #include "field/detail/segment_store.h"
 #include "strata/core/error.h"
+#include "strata/core/format.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,7 +28,7 @@ class ExactField final : public LayerField {
         // Buckets count from the layer's corner: only its size matters, not where it lies.
         const Vec2 size = layer.bounds().size();
         if (indexed_ && (size.x + size.y) / params.bucket_size > 1e9)
-            throw InvalidInput("make_field: layer '" + layer.name +
+            throw InvalidInput("make_field: layer '" + shown_text(layer.name) +
                                "' is too large for the bucket size");
         store_.build(layer.points, layer.closed, outside_sign);
         set_outside_sign(store_.outside_sign());

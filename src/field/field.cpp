@@ -92,7 +92,8 @@ namespace {
 void check_field_args(const Layer& layer, int outside_sign, const ResolvedFieldParams& params) {
     if (outside_sign != 1 && outside_sign != -1)
         throw InvalidInput("make_field: outside_sign must be +1 or -1 (got " +
-                           std::to_string(outside_sign) + ") for layer '" + layer.name + "'");
+                           std::to_string(outside_sign) + ") for layer '" + shown_text(layer.name) +
+                           "'");
     if (!(params.voxel_size > 0.0) || !(params.band_width > 0.0) || !(params.bucket_size > 0.0) ||
         !std::isfinite(params.voxel_size) || !std::isfinite(params.band_width) ||
         !std::isfinite(params.bucket_size))

@@ -403,7 +403,7 @@ class GridStack {
         for (std::size_t i = begin; i < end; ++i)
             if (const Vec2& p = points[i]; !(std::abs(p.x / h_) + band_ / h_ < 0.5 * kMaxIndex &&
                                              std::abs(p.y / h_) + band_ / h_ < 0.5 * kMaxIndex))
-                throw InvalidInput("make_field: layer '" + layer +
+                throw InvalidInput("make_field: layer '" + shown_text(layer) +
                                    "' spans more than 2^29 "
                                    "voxels of size " +
                                    format_number(h_) + " (raise FieldParams::voxel_size)");
@@ -787,7 +787,7 @@ std::string coord_text(const openvdb::Coord& c) {
 const GridField& as_grid(const LayerField& field, const char* where) {
     const auto* g = dynamic_cast<const GridField*>(&field);
     if (g == nullptr)
-        throw InvalidInput(std::string(where) + ": layer '" + field.name() +
+        throw InvalidInput(std::string(where) + ": layer '" + shown_text(field.name()) +
                            "' does not use the Grid backend");
     return *g;
 }

@@ -851,7 +851,7 @@ void validate_outside_sides(const Scene& scene, const CheckParams& params) {
     for (std::size_t i = 0; i < params.outside_sides.size(); ++i)
         if (!scene.layer(i).closed && params.outside_sides[i] != 1 && params.outside_sides[i] != -1)
             throw InvalidInput("check: params.outside_sides[" + std::to_string(i) + "] (layer '" +
-                               scene.layer(i).name + "') must be +1 or -1 (got " +
+                               shown_text(scene.layer(i).name) + "') must be +1 or -1 (got " +
                                std::to_string(params.outside_sides[i]) + ")");
 }
 

@@ -28,7 +28,7 @@ const char* relation_name(Relation r) {
 namespace {
 
 std::string layer_label(const Layer& layer, std::size_t index) {
-    return "layer '" + layer.name + "' (#" + std::to_string(index) + ")";
+    return "layer '" + shown_text(layer.name) + "' (#" + std::to_string(index) + ")";
 }
 
 void check_finite(const Layer& layer, const std::string& label) {
@@ -61,7 +61,7 @@ std::size_t remove_duplicates(std::vector<Vec2>& points, bool closed) {
 }  // namespace
 
 std::size_t validate_layer(Layer& layer) {
-    const std::string label = "layer '" + layer.name + "'";
+    const std::string label = "layer '" + shown_text(layer.name) + "'";
     if (layer.name.empty()) throw InvalidInput("layer: name must not be empty");
     auto check_range = [&](const char* field, double value, double lo, double hi, bool open_lo) {
         const bool ok = std::isfinite(value) && (open_lo ? value > lo : value >= lo) && value <= hi;
@@ -112,11 +112,11 @@ Scene::Scene(std::vector<Layer> layers, std::string units)
             for (const std::string& name : *layers_[i].outer) {
                 auto it = index.find(name);
                 if (it == index.end())
-                    throw InvalidInput(layer_label(layers_[i], i) + ": outer names '" + name +
-                                       "', which is not a layer of the scene");
+                    throw InvalidInput(layer_label(layers_[i], i) + ": outer names '" +
+                                       shown_text(name) + "', which is not a layer of the scene");
                 if (std::find(outer_[i].begin(), outer_[i].end(), it->second) != outer_[i].end()) {
                     diagnostics_.notes.push_back(layer_label(layers_[i], i) + ": outer lists '" +
-                                                 name + "' twice; counted once");
+                                                 shown_text(name) + "' twice; counted once");
                     continue;
                 }
                 outer_[i].push_back(it->second);
@@ -160,7 +160,7 @@ Scene::Scene(std::vector<Layer> layers, std::string units)
         std::string cycle;
         auto first = std::find(path.begin(), path.end(), path.back());
         for (auto it = first; it != path.end(); ++it)
-            cycle += (it == first ? "" : " -> ") + ("'" + layers_[*it].name + "'");
+            cycle += (it == first ? "" : " -> ") + ("'" + shown_text(layers_[*it].name) + "'");
         throw InvalidInput("scene: outer links form a cycle: " + cycle);
     }
 

@@ -446,7 +446,7 @@ class Reader {
             if (!it->is_string())
                 fail(where + ".name", "expected a string (got " + shown(*it) + ")");
             layer.name = it->get<std::string>();
-            label = where + " ('" + layer.name + "')";
+            label = where + " ('" + shown_text(layer.name) + "')";
         }
         bool has_points = false;
         for (auto it = object.begin(); it != object.end(); ++it) {

@@ -426,17 +426,17 @@ SliceMesh make_slice_mesh(std::string name, std::vector<glm::dvec3> vertices,
     for (std::size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c)
             if (!std::isfinite(vertices[i][c]))
-                throw InvalidInput("mesh '" + mesh.name + "': vertex " + std::to_string(i) +
-                                   " has a non-finite coordinate (" +
+                throw InvalidInput("mesh '" + shown_text(mesh.name) + "': vertex " +
+                                   std::to_string(i) + " has a non-finite coordinate (" +
                                    format_number(vertices[i][c]) + ")");
     mesh.vertices = std::move(vertices);
     for (std::size_t f = 0; f < polygons.size(); ++f) {
         const auto& poly = polygons[f];
         for (std::uint32_t v : poly)
             if (v >= n)
-                throw InvalidInput("mesh '" + mesh.name + "': face " + std::to_string(f) +
-                                   " uses vertex " + std::to_string(v) + " of " +
-                                   std::to_string(n));
+                throw InvalidInput("mesh '" + shown_text(mesh.name) + "': face " +
+                                   std::to_string(f) + " uses vertex " + std::to_string(v) +
+                                   " of " + std::to_string(n));
         for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
             const std::array<std::uint32_t, 3> t{poly[0], poly[k], poly[k + 1]};
             if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
@@ -1137,7 +1137,7 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
     std::map<std::string, std::size_t> by_name;
     for (std::size_t m = 0; m < meshes.size(); ++m)
         if (!by_name.emplace(meshes[m].name, m).second)
-            throw InvalidInput("slice: two meshes are named '" + meshes[m].name + "'");
+            throw InvalidInput("slice: two meshes are named '" + shown_text(meshes[m].name) + "'");
     std::vector<std::size_t> sequence;
     std::vector<int> mesh_rank(meshes.size(), -1);
     for (const std::string& name : params.order) {
@@ -1149,7 +1149,7 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
                                "', which is not a mesh (meshes: " + known + ")");
         }
         if (mesh_rank[it->second] >= 0)
-            throw InvalidInput("slice: params.order names '" + name + "' twice");
+            throw InvalidInput("slice: params.order names '" + shown_text(name) + "' twice");
         mesh_rank[it->second] = static_cast<int>(sequence.size());
         sequence.push_back(it->second);
     }

@@ -49,10 +49,9 @@ struct Origin {
     throw InvalidInput(origin.prefix() + what);
 }
 
-// `text` shortened for a message.
+// `text` shortened and shown safely for a message.
 std::string excerpt(std::string_view text, std::size_t max_chars = 40) {
-    if (text.size() <= max_chars) return std::string(text);
-    return std::string(text.substr(0, max_chars)) + "...";
+    return shown_text(text, max_chars);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -298,7 +297,7 @@ Affine parse_transform(std::string_view text, const Origin& origin) {
             if (cos_a == 0.0) bad(name + " of " + format_number(args[0]) + " degrees");
             (name == "skewX" ? m.c : m.b) = sin_a / cos_a;
         } else {
-            bad("unknown function '" + name + "'");
+            bad("unknown function '" + excerpt(name) + "'");
         }
         result = compose(result, m);
     }
@@ -503,7 +502,7 @@ std::vector<Subpath> parse_path_data(std::string_view d, const OutputMap& map, d
         end = std::min(d.size(), std::max(end, group_start + 1));
         std::string_view near = d.substr(group_start, end - group_start);
         if (near.size() > 40) near = near.substr(near.size() - 40);
-        fail(origin, "d: bad path data near '" + std::string(trim(near)) + "' (" + why + ")");
+        fail(origin, "d: bad path data near '" + excerpt(trim(near)) + "' (" + why + ")");
     };
 
     Vec2 current(0.0), start(0.0), last_cubic(0.0), last_quad(0.0);
@@ -677,9 +676,9 @@ class SvgReader {
         for (std::size_t i = 0; i < layers_.size(); ++i) {
             const auto [it, inserted] = index.emplace(layers_[i].name, i);
             if (!inserted)
-                fail(origins_[i], "layer name '" + layers_[i].name + "' is already used by " +
-                                      origins_[it->second].element + " at line " +
-                                      std::to_string(origins_[it->second].line));
+                fail(origins_[i], "layer name '" + excerpt(layers_[i].name) +
+                                      "' is already used by " + origins_[it->second].element +
+                                      " at line " + std::to_string(origins_[it->second].line));
         }
         if (any_outer_) {
             for (std::size_t i = 0; i < layers_.size(); ++i) {
@@ -687,8 +686,8 @@ class SvgReader {
                 if (!layer.outer) layer.outer.emplace();
                 for (const std::string& name : *layer.outer)
                     if (index.find(name) == index.end())
-                        fail(origins_[i],
-                             "data-outer names '" + name + "', which is not a layer of the file");
+                        fail(origins_[i], "data-outer names '" + excerpt(name) +
+                                              "', which is not a layer of the file");
             }
         }
         try {
@@ -701,7 +700,7 @@ class SvgReader {
   private:
     Origin origin_of(const tinyxml2::XMLElement* e, std::string_view name) const {
         std::string element = "<" + std::string(name);
-        if (const char* id = e->Attribute("id")) element += " id='" + std::string(id) + "'";
+        if (const char* id = e->Attribute("id")) element += " id='" + excerpt(id) + "'";
         element += ">";
         return {source_, e->GetLineNum(), element};
     }

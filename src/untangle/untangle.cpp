@@ -30,8 +30,8 @@ void validate_sides(const Scene& scene, const UntangleParams& params) {
     for (std::size_t i = 0; i < outside.size(); ++i)
         if (!scene.layer(i).closed && outside[i] != 1 && outside[i] != -1)
             throw InvalidInput("untangle: params.outside_sides[" + std::to_string(i) +
-                               "] (layer '" + scene.layer(i).name + "') must be +1 or -1 (got " +
-                               std::to_string(outside[i]) + ")");
+                               "] (layer '" + shown_text(scene.layer(i).name) +
+                               "') must be +1 or -1 (got " + std::to_string(outside[i]) + ")");
     const InputSides* sides = params.input_sides;
     if (sides && !sides->empty() && sides->size() != scene.size())
         throw InvalidInput("untangle: params.input_sides has " + std::to_string(sides->size()) +

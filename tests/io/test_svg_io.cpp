@@ -565,6 +565,16 @@ TEST_CASE("bad SVG input is rejected with file, line, attribute and value", "[io
         CHECK_THAT(error_of(head + "<polygon id=\"flat\" points=\"0 0 1 1 0 0\"/></svg>"),
                    Contains("bad.svg:2") && Contains("flat") && Contains("at least 3"));
     }
+    SECTION("ids and names with control or broken bytes are shown as \\xNN (fuzz_svg)") {
+        // A fuzzed id held the byte 0x9b, which the message printed raw.
+        const std::string msg =
+            error_of(head + "<polyline id=\"a\x9b\x1b[1m\" points=\"0,0 1,zz\"/></svg>");
+        CHECK_THAT(msg, Contains("<polyline id='a\\x9b\\x1b[1m'>") && Contains("zz"));
+        CHECK(msg.find('\x1b') == std::string::npos);
+        CHECK_THAT(error_of(head + "<polyline id=\"a\" points=\"0 0 1 1\" data-outer=\"q\x7f\"/>"
+                                   "</svg>"),
+                   Contains("data-outer names 'q\\x7f'"));
+    }
     SECTION("nothing to read") {
         CHECK_THAT(error_of(head + "<defs><path d=\"M0 0 L1 1\"/></defs><text>x</text></svg>"),
                    Contains("bad.svg") && Contains("nothing to read"));

@@ -2,6 +2,7 @@
 #include "io/detail/mesh_text.h"
 
 #include "strata/core/error.h"
+#include "strata/core/format.h"
 
 #include <algorithm>
 #include <cctype>
@@ -45,24 +46,6 @@ std::vector<TextToken> line_tokens(const std::string& line, std::size_t line_num
                        std::to_string(at.column) + ": " + what);
 }
 
-// A token for an error message: at most 40 characters, bytes outside printable ASCII as \xNN
-// (binary junk would cut or garble the one-line message).
-std::string shown_token(const std::string& text) {
-    std::string out;
-    for (std::size_t i = 0; i < text.size() && out.size() < 37; ++i) {
-        const auto c = static_cast<unsigned char>(text[i]);
-        if (c >= 0x20 && c < 0x7f) {
-            out += static_cast<char>(c);
-        } else {
-            static const char* hex = "0123456789abcdef";
-            out += "\\x";
-            out += hex[c >> 4];
-            out += hex[c & 15];
-        }
-    }
-    return out.size() < text.size() ? out + "..." : out;
-}
-
 // A finite coordinate, or an error naming the token.
 double check_coordinate(const std::filesystem::path& path, const TextToken& t) {
     const char* begin = t.text.c_str();
@@ -70,9 +53,9 @@ double check_coordinate(const std::filesystem::path& path, const TextToken& t) {
     const double v = std::strtod(begin, &end);
     // The whole token: an embedded NUL would end the C string early.
     if (end == begin || end != begin + t.text.size())
-        mesh_text_error(path, t, "expected a number (got '" + shown_token(t.text) + "')");
+        mesh_text_error(path, t, "expected a number (got '" + shown_text(t.text) + "')");
     if (!std::isfinite(v))
-        mesh_text_error(path, t, "coordinate is not finite (got '" + shown_token(t.text) + "')");
+        mesh_text_error(path, t, "coordinate is not finite (got '" + shown_text(t.text) + "')");
     return v;
 }
 
@@ -85,7 +68,7 @@ long long integer_token(const std::filesystem::path& path, const TextToken& t,
     const long long v = std::strtoll(begin, &end, 10);
     if (end == begin || end != begin + text.size() || errno == ERANGE)
         mesh_text_error(path, t,
-                        std::string("expected ") + what + " (got '" + shown_token(t.text) + "')");
+                        std::string("expected ") + what + " (got '" + shown_text(t.text) + "')");
     return v;
 }
 
@@ -175,7 +158,7 @@ PlyLayout validate_ply_header(const std::filesystem::path& path, std::istream& i
     const auto file_size = static_cast<long long>(std::filesystem::file_size(path, ec));
     auto check_type = [&](const TextToken& t) {
         if (types.count(t.text) == 0)
-            mesh_text_error(path, t, "unknown PLY property type '" + shown_token(t.text) + "'");
+            mesh_text_error(path, t, "unknown PLY property type '" + shown_text(t.text) + "'");
     };
     auto expect_count = [&](const std::vector<TextToken>& tokens, std::size_t count,
                             const char* form) {
@@ -211,12 +194,12 @@ PlyLayout validate_ply_header(const std::filesystem::path& path, std::istream& i
             if (tokens[1].text != "ascii" && tokens[1].text != "binary_little_endian" &&
                 tokens[1].text != "binary_big_endian")
                 mesh_text_error(path, tokens[1],
-                                "unknown PLY format '" + shown_token(tokens[1].text) + "'");
+                                "unknown PLY format '" + shown_text(tokens[1].text) + "'");
             // The only PLY version (OpenMesh allocated 2 GB on "ascii 333...1").
             if (check_coordinate(path, tokens[2]) != 1.0)
                 mesh_text_error(
                     path, tokens[2],
-                    "unsupported PLY version '" + shown_token(tokens[2].text) + "' (expected 1.0)");
+                    "unsupported PLY version '" + shown_text(tokens[2].text) + "' (expected 1.0)");
             format = true;
             layout.ascii = tokens[1].text == "ascii";
             layout.big_endian = tokens[1].text == "binary_big_endian";
@@ -254,7 +237,7 @@ PlyLayout validate_ply_header(const std::filesystem::path& path, std::istream& i
                     {tokens[2].text, false, "", tokens[1].text});
             }
         } else {
-            mesh_text_error(path, tokens[0], "unknown PLY header line '" + shown_token(key) + "'");
+            mesh_text_error(path, tokens[0], "unknown PLY header line '" + shown_text(key) + "'");
         }
     }
     mesh_text_error(path, {"", n, 1}, "the PLY header has no end_header line");
@@ -268,8 +251,8 @@ void validate_ply_body(const std::filesystem::path& path, std::istream& in,
                        const PlyLayout& layout) {
     const std::string what_ends = "the file ends before its data does (";
     auto where = [](const PlyElement& e, long long k, const PlyProperty& p) {
-        return "element '" + shown_token(e.name) + "' " + std::to_string(k) + " of " +
-               std::to_string(e.count) + ", property '" + shown_token(p.name) + "'";
+        return "element '" + shown_text(e.name) + "' " + std::to_string(k) + " of " +
+               std::to_string(e.count) + ", property '" + shown_text(p.name) + "'";
     };
     if (layout.ascii) {
         std::string line;
@@ -368,7 +351,7 @@ OffMesh read_off_text(const std::filesystem::path& path) {
     const std::string& magic = tokens[0].text;
     if (!is_off_magic(magic))
         mesh_text_error(path, tokens[0],
-                        "not an OFF header (got '" + shown_token(magic) +
+                        "not an OFF header (got '" + shown_text(magic) +
                             "'; expected OFF, COFF, NOFF, STOFF ...)");
     if (magic.find('4') != std::string::npos || magic.find('n') != std::string::npos)
         mesh_text_error(path, tokens[0],
@@ -380,7 +363,7 @@ OffMesh read_off_text(const std::filesystem::path& path) {
         mesh_text_error(path, tokens[1],
                         "the OFF header line must hold only '" + magic +
                             "' (the counts go on the next line; got '" +
-                            shown_token(tokens[1].text) + "')");
+                            shown_text(tokens[1].text) + "')");
     }
     std::size_t next = 1;
     auto take = [&](const char* what) -> const TextToken& {
