@@ -142,6 +142,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"input", opt->input},
                 {"output", opt->output},
                 {"backend", backend_name(params.field.backend)},
+                {"tries", r.tries},
                 {"passes", r.passes},
                 {"rounds", r.rounds},
                 {"converged", r.converged},
@@ -198,9 +199,9 @@ Run add_untangle_command(CLI::App& app) {
             "%.4g\n",
             r.min_separation_ratio_after, r.moved_vertices, r.free_vertices, r.max_displacement);
         std::printf(
-            "passes: %d, rounds: %d, %s; time %.3f s (fields %.3f, untangle %.3f, finish %.3f, "
-            "check %.3f)\n",
-            r.passes, r.rounds,
+            "tries: %d, passes: %d, rounds: %d, %s; time %.3f s (fields %.3f, untangle %.3f, "
+            "finish %.3f, check %.3f)\n",
+            r.tries, r.passes, r.rounds,
             r.collision_free ? "collision-free"
             : r.converged    ? "converged, NOT collision-free"
                              : "NOT collision-free at the pass cap",
@@ -213,7 +214,7 @@ Run add_untangle_command(CLI::App& app) {
                 why = layer.closed && is_flat(layer.points)
                           ? "; layer '" + shown_text(layer.name) +
                                 "' is flat: all its points are collinear"
-                          : "; layer '" + layer.name + "' crosses itself (segments " +
+                          : "; layer '" + shown_text(layer.name) + "' crosses itself (segments " +
                                 std::to_string(c.segment_a) + " and " +
                                 std::to_string(c.segment_b) + " at (" + format_number(c.point.x) +
                                 ", " + format_number(c.point.y) + "))";

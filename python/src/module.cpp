@@ -430,6 +430,7 @@ PYBIND11_MODULE(_strata, m) {
     });
 
     py::class_<UntangleReport>(m, "UntangleReport")
+        .def_readonly("tries", &UntangleReport::tries)
         .def_readonly("passes", &UntangleReport::passes)
         .def_readonly("rounds", &UntangleReport::rounds)
         .def_readonly("converged", &UntangleReport::converged)

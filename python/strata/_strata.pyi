@@ -140,6 +140,7 @@ class SimplifyReport:
         """The report as ``strata simplify --report`` writes it."""
 
 class UntangleReport:
+    tries: int  #: Untanglings from the input; passes, rounds and seconds count them all.
     passes: int
     rounds: int
     converged: bool

@@ -61,6 +61,7 @@ UntangleReport run(Scene& scene, const std::vector<Piece>& pieces, const Untangl
     validate(params);
     validate_sides(scene, params);
     UntangleReport report;
+    report.tries = 1;
     const Scene original = scene;
     try {
         for (const Piece& piece : pieces)
@@ -416,12 +417,37 @@ UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const P
     return report;
 }
 
-// The second try's report, counting the passes and rounds of the first.
-UntangleReport after(UntangleReport second, const UntangleReport& first) {
-    second.passes += first.passes;
-    second.rounds += first.rounds;
-    return second;
-}
+// What the tries of one call cost (UntangleReport::tries, passes, rounds, finishes,
+// finish_moves and seconds), summed over every try whichever try's result is kept.
+struct TriesCost {
+    UntangleReport sum;
+
+    void add(const UntangleReport& r) {
+        sum.tries += r.tries;
+        sum.passes += r.passes;
+        sum.rounds += r.rounds;
+        sum.finishes += r.finishes;
+        sum.finish_moves += r.finish_moves;
+        sum.seconds_fields += r.seconds_fields;
+        sum.seconds_untangle += r.seconds_untangle;
+        sum.seconds_check += r.seconds_check;
+        sum.seconds_finish += r.seconds_finish;
+    }
+
+    // `kept` (the result of one of the tries) with the cost of all of them.
+    UntangleReport charged_to(UntangleReport kept) const {
+        kept.tries = sum.tries;
+        kept.passes = sum.passes;
+        kept.rounds = sum.rounds;
+        kept.finishes = sum.finishes;
+        kept.finish_moves = sum.finish_moves;
+        kept.seconds_fields = sum.seconds_fields;
+        kept.seconds_untangle = sum.seconds_untangle;
+        kept.seconds_check = sum.seconds_check;
+        kept.seconds_finish = sum.seconds_finish;
+        return kept;
+    }
+};
 
 }  // namespace
 
@@ -453,14 +479,13 @@ UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, bool
     longer.long_rounds_factor = 1;
     Scene attempt = input;
     UntangleReport second = tries(attempt, longer);
-    if (!second.collision_free) {
-        report.passes += second.passes;
-        report.rounds += second.rounds;
-        return report;
-    }
+    TriesCost cost;
+    cost.add(report);
+    cost.add(second);
+    if (!second.collision_free) return cost.charged_to(report);
     scene = std::move(attempt);
     second.long_rounds = true;
-    return after(second, report);
+    return cost.charged_to(second);
 }
 
 UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
@@ -473,9 +498,12 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
     // and shape matching make them, and nothing takes them out: docs/untangle.md).
     Scene simple = input;
     UntangleReport second = untangle_once(simple, params, progress, true);
-    if (!second.collision_free) return report;
+    TriesCost cost;
+    cost.add(report);
+    cost.add(second);
+    if (!second.collision_free) return cost.charged_to(report);
     scene = std::move(simple);
-    return after(second, report);
+    return cost.charged_to(second);
 }
 
 UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
@@ -495,14 +523,13 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     const Scene input = scene;
     UntangleReport first;  // the global order's first try: the result when nothing is clean
     Scene first_scene;
-    int passes = 0, rounds = 0;
+    TriesCost cost;
     // One try from the input into `attempt`; true when it comes out clean.
     auto clean_try = [&](const UntangleParams& p, bool keep_simple, Scene& attempt,
                          UntangleReport& report) {
         attempt = input;
         report = untangle_once(attempt, p, progress, keep_simple);
-        passes += report.passes;
-        rounds += report.rounds;
+        cost.add(report);
         return report.collision_free;
     };
     for (bool keep_simple : {false, true}) {
@@ -524,10 +551,8 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
             report.inferred_sides = true;
             if (kept) *kept = std::move(inferred);
         }
-        report.passes = passes;
-        report.rounds = rounds;
         scene = std::move(attempt);
-        return report;
+        return cost.charged_to(report);
     }
     // Neither is clean: the other readings of the regions whose recorded sides disagree
     // (InputSides::region_alternatives(), at most params.other_readings of them, best fitting
@@ -557,14 +582,12 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
         if (best == others.size()) continue;
         best_report.inferred_sides = true;
         best_report.sides_reading = best + 1;
-        best_report.passes = passes;
-        best_report.rounds = rounds;
         if (kept) *kept = std::move(others[best]);
         scene = std::move(best_scene);
-        return best_report;
+        return cost.charged_to(best_report);
     }
     scene = std::move(first_scene);
-    return first;
+    return cost.charged_to(first);
 }
 
 }  // namespace

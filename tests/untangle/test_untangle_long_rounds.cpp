@@ -49,6 +49,8 @@ TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded 
         CHECK(report.collision_free);
         CHECK(report.long_rounds);
         CHECK(report.passes > before.passes);  // the failed tries count too
+        CHECK(report.tries > before.tries);
+        CHECK(before.tries >= 2);
         const CheckReport c = check_scene(out, judged);
         CHECK(c.is_collision_free());
         CHECK(c.separations_hold());
@@ -70,6 +72,7 @@ TEST_CASE("untangle_inferring_sides: a scene the first try cleans gets no longer
     const UntangleReport rb = untangle_inferring_sides(b, without);
     REQUIRE(ra.collision_free);
     CHECK_FALSE(ra.long_rounds);
+    CHECK(ra.tries == 1);
     CHECK(ra.passes == rb.passes);
     for (std::size_t l = 0; l < a.size(); ++l) CHECK(a.layer(l).points == b.layer(l).points);
 }
@@ -80,6 +83,12 @@ TEST_CASE("untangle() itself does not retry with longer rounds", "[untangle]") {
     const UntangleReport report = untangle(out, UntangleParams{});
     CHECK_FALSE(report.collision_free);
     CHECK_FALSE(report.long_rounds);
+    // Both tries (the second one making no self-crossing) ran to the pass cap, and the report
+    // counts both, though the result is the first's.
+    CHECK(report.tries == 2);
+    CHECK_FALSE(report.kept_simple);
+    CHECK(report.passes == 2 * UntangleParams{}.max_passes);
+    CHECK(report.rounds == report.passes);
 }
 
 TEST_CASE("untangle_inferring_sides: with the original's sides, longer rounds when the tries fail",

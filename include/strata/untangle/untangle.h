@@ -131,6 +131,11 @@ void validate(const UntangleParams& params);
 
 /// What an untangling did.
 struct UntangleReport {
+    /// Untanglings run from the input: 1, or more where untangle() and
+    /// untangle_inferring_sides() try again (a second try, other readings, long rounds).
+    /// passes, rounds, finishes, finish_moves and the seconds count all of them; the other
+    /// fields are those of the result kept.
+    int tries = 0;
     int passes = 0;          ///< Passes run (fields built from the current geometry).
     int rounds = 0;          ///< Rounds run, over all passes.
     bool converged = false;  ///< The last pass met the tolerance before max_rounds.
@@ -160,11 +165,10 @@ struct UntangleReport {
     /// and the kept sides are the i-th other reading (InputSides::region_alternatives()).
     std::size_t sides_reading = 0;
     /// untangle(): the first try did not come out clean, and the result is the second, from
-    /// the input, in which no vertex move makes a self-crossing (passes and rounds count both).
+    /// the input, in which no vertex move makes a self-crossing.
     bool kept_simple = false;
     /// untangle_inferring_sides(): every try with params.gradient_steps failed, and the result
-    /// is that of the retry with params.long_rounds_factor times as many (passes and rounds:
-    /// the retry's plus those of the failed tries' report).
+    /// is that of the retry with params.long_rounds_factor times as many.
     bool long_rounds = false;
 };
 
