@@ -63,6 +63,7 @@ nlohmann::json report_json(const SimplifyReport& r, const SimplifyReport* naive)
                         {"refused", r.refused},
                         {"gave_up", r.gave_up},
                         {"chord_shifts", r.chord_shifts},
+                        {"shape_refused", r.shape_refused},
                         {"deferred", r.deferred},
                         {"rounds", r.rounds},
                         {"batches", r.batches},

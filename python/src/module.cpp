@@ -377,6 +377,7 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("refused", &SimplifyReport::refused)
         .def_readonly("gave_up", &SimplifyReport::gave_up)
         .def_readonly("chord_shifts", &SimplifyReport::chord_shifts)
+        .def_readonly("shape_refused", &SimplifyReport::shape_refused)
         .def_readonly("deferred", &SimplifyReport::deferred)
         .def_readonly("batches", &SimplifyReport::batches)
         .def_readonly("targets_met", &SimplifyReport::targets_met)

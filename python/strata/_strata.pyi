@@ -115,6 +115,7 @@ class SimplifyReport:
     refused: int
     gave_up: int
     chord_shifts: int
+    shape_refused: int
     deferred: int
     batches: int
     targets_met: bool

@@ -117,6 +117,10 @@ struct SimplifyReport {
     /// chord toward the removed vertex, out of what it cut into, without an untangling pass
     /// (docs/simplify.md, *Rolled parts: shifting a chord*).
     std::size_t chord_shifts = 0;
+    /// Of the refused removals, those on a rolled part whose untangling succeeded but left the
+    /// shape around it farther from the input than the removal alone by more than the layer's
+    /// separation (docs/simplify.md, *Rolled parts: the shape error bound*).
+    std::size_t shape_refused = 0;
     std::size_t deferred = 0;        ///< Removals set aside (UntangleSchedule::Deferred).
     int rounds = 0;                  ///< Untangling rounds over all calls.
     /// Untanglings of a batch run once more alone, because their vertices came within reach

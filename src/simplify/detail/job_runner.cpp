@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -26,7 +27,100 @@ bool is_waiting_stamp(const std::vector<Job>& waiting, std::uint32_t m) {
     return false;
 }
 
+// The alive vertex `steps` links before (step -1) or after (+1) x, or the last one there is.
+std::size_t walk(const WorkLayer& w, std::size_t x, int steps) {
+    for (int i = 0; i < std::abs(steps); ++i) {
+        const std::size_t y = steps < 0 ? w.prev[x] : w.next[x];
+        if (y == kNone) break;
+        x = y;
+    }
+    return x;
+}
+
+// The input vertices of w from id `from` to id `to` (wrapping on a closed layer), in order.
+template <typename F>
+void for_input_ids(const WorkLayer& w, std::size_t from, std::size_t to, F&& f) {
+    const std::size_t n = w.original.size();
+    for (std::size_t i = from;; i = (i + 1) % n) {
+        f(i);
+        if (i == to) break;
+    }
+}
+
 }  // namespace
+
+// The shape error around x (alive vertex of layer k), with the positions `at` gives: the
+// larger of the distance from x to the input polyline between the alive vertices two links
+// before and after it, and the distance from the input vertices between x's alive neighbours
+// to the simplified polyline's four segments around x (so a vertex that slides along its own
+// layer by less than a segment's length adds nothing). A local symmetric Hausdorff distance.
+template <typename At>
+double JobRunner::shape_error(std::size_t k, std::size_t x, At&& at) const {
+    const WorkLayer& w = live_.layer(k);
+    const std::size_t p = walk(w, x, -1), n = walk(w, x, 1);
+    const std::size_t p2 = walk(w, x, -2), n2 = walk(w, x, 2);
+    double out = std::numeric_limits<double>::infinity();
+    if (p2 == n2) {
+        out = glm::distance(at(k, x), w.original[x]);
+    } else {
+        for_input_ids(w, p2, n2, [&](std::size_t i) {
+            if (i != n2)
+                out =
+                    std::min(out, point_segment_distance(at(k, x), w.original[i],
+                                                         w.original[(i + 1) % w.original.size()]));
+        });
+    }
+    double in = 0.0;
+    if (p != n) {
+        const Vec2 q[5] = {at(k, p2), at(k, p), at(k, x), at(k, n), at(k, n2)};
+        for_input_ids(w, p, n, [&](std::size_t i) {
+            double d = std::numeric_limits<double>::infinity();
+            for (int s = 0; s < 4; ++s)
+                d = std::min(d, point_segment_distance(w.original[i], q[s], q[s + 1]));
+            in = std::max(in, d);
+        });
+    }
+    return std::max(out, in);
+}
+
+// The largest shape_error() over every alive vertex of the layers the job's runs are in, at
+// their live positions (before the job): what the simplification has left so far.
+double JobRunner::layers_shape_error(const Job& job) const {
+    auto at = [&](std::size_t k, std::size_t id) { return live_.layer(k).pos[id]; };
+    std::vector<char> seen(live_.size(), 0);
+    double worst = 0.0;
+    for (const Run& run : job.runs) {
+        if (seen[run.layer]) continue;
+        seen[run.layer] = 1;
+        const WorkLayer& w = live_.layer(run.layer);
+        const std::size_t first = w.first();
+        if (first == kNone) continue;
+        std::size_t x = first;
+        while (w.prev[x] != kNone && w.prev[x] != first) x = w.prev[x];  // an open layer's start
+        const std::size_t start = x;
+        do {
+            worst = std::max(worst, shape_error(run.layer, x, at));
+            x = w.next[x];
+        } while (x != kNone && x != start);
+    }
+    return worst;
+}
+
+// The largest shape_error() over the job's free vertices: before it ran (live positions), or
+// with the work scene's.
+double JobRunner::job_shape_error(const Job& job, bool after) const {
+    auto at = [&](std::size_t k, std::size_t id) {
+        if (after && slots_.mark[k][id] == job.stamp)
+            return job.work->layer(slots_.run[k][id]).points[slots_.index[k][id]];
+        return live_.layer(k).pos[id];
+    };
+    double worst = 0.0;
+    for (std::size_t r = 0; r < job.runs.size(); ++r)
+        for (std::size_t k = 0; k < job.runs[r].ids.size(); ++k)
+            if (job.pieces[r].is_free[k])
+                worst = std::max(worst, shape_error(job.runs[r].layer, job.runs[r].ids[k], at));
+    return worst;
+}
 
 JobRunner::JobRunner(const Scene& input, const SimplifyParams& params,
                      const EngineSettings& settings, LivePolylines& live,
@@ -266,7 +360,22 @@ void JobRunner::execute(Job& job) const {
         // Sides of the open layers, as the input gives them (a rolled part stays rolled).
         return check_.sides_kept(ov);
     };
-    job.shifted = job.rolled && shift_chord(job, is_ok);
+    // A rolled job's result (a shifted chord or an untangling) may leave the shape around its
+    // free vertices (shape_error()) farther from the input than the removal alone would by at
+    // most the removal's layer's separation (what an untangling must move a layer by), or
+    // else no farther than the shape error its layers already have elsewhere (so it does not
+    // raise their Hausdorff distance). Beyond both it is refused. Jobs without a rolled vertex
+    // are not bounded, so scenes without rolls keep their outputs.
+    const double error_bound =
+        job.rolled ? job_shape_error(job, false) + separations_.reach[job.l] : 0.0;
+    double layers_error = -1.0;  // the job's layers' largest shape error, when first needed
+    auto within_bound = [&] {
+        const double error = job_shape_error(job, true);
+        if (error <= error_bound) return true;
+        if (layers_error < 0.0) layers_error = layers_shape_error(job);
+        return error <= layers_error;
+    };
+    job.shifted = job.rolled && shift_chord(job, is_ok, within_bound);
     if (job.shifted) {
         job.result = EngineResult{};
         job.result.ok = true;
@@ -274,6 +383,10 @@ void JobRunner::execute(Job& job) const {
     }
     job.result = run_engine(*job.work, job.pieces, params_.untangling, job.relations, job.settings,
                             is_ok, {});
+    if (job.rolled && job.result.ok && !within_bound()) {
+        job.result.ok = false;
+        job.shape_refused = true;
+    }
 }
 
 // A removal whose chord (a, b) crosses nothing but comes closer than their separation to other
@@ -283,11 +396,13 @@ void JobRunner::execute(Job& job) const {
 // separation, to the checked one (need), twice those; never beyond the removed vertex's
 // distance to the chord. One is kept when no vertex lies in the area that (before a, a),
 // (a, b) and (b, after b) sweep (so nothing tunnels: that area's old sides are live segments
-// and the crossing-free chord) and `is_ok` (the job's exact check) passes; the work scene is
-// left as it was otherwise. Tried for rolled jobs only (Job::rolled), before the untangling:
-// there the untangling of such a removal moved the whole fold and gave up (collar_wrap,
-// docs/simplify.md); other jobs run as before, so scenes without rolls keep their outputs.
-bool JobRunner::shift_chord(Job& job, const std::function<bool(const Scene&)>& is_ok) const {
+// and the crossing-free chord), `is_ok` (the job's exact check) passes and the shape error
+// stays within bounds (`within_bound`, execute()); the work scene is left as it was otherwise.
+// Tried for rolled jobs only (Job::rolled), before the untangling: there the untangling of such a
+// removal moved the whole fold and gave up (collar_wrap, docs/simplify.md); other jobs run as
+// before, so scenes without rolls keep their outputs.
+bool JobRunner::shift_chord(Job& job, const std::function<bool(const Scene&)>& is_ok,
+                            const std::function<bool()>& within_bound) const {
     const std::size_t l = job.l, a = job.a, b = job.b;
     const WorkLayer& w = live_.layer(l);
     if (!slots_.is_free(l, a, job) || !slots_.is_free(l, b, job)) return false;
@@ -371,7 +486,7 @@ bool JobRunner::shift_chord(Job& job, const std::function<bool(const Scene&)>& i
         };
         set(ra, ka, qa);
         set(rb, kb, qb);
-        if (is_ok(work)) return true;
+        if (is_ok(work) && within_bound()) return true;
         set(ra, ka, pa);
         set(rb, kb, pb);
     }

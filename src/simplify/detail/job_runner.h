@@ -46,9 +46,19 @@ class JobRunner {
   private:
     void local_sides(Job& job) const;
     /// Keeps the removal of a rolled job by moving its chord's two ends toward the removed
-    /// vertex, out of the layers the chord came too close to, when `is_ok` passes: true, the
-    /// work scene moved; false, it is as it was.
-    bool shift_chord(Job& job, const std::function<bool(const Scene&)>& is_ok) const;
+    /// vertex, out of the layers the chord came too close to, when `is_ok` passes and the shape
+    /// error stays within bounds (`within_bound`, execute()): true, the work scene moved; false, it
+    /// is as it was.
+    bool shift_chord(Job& job, const std::function<bool(const Scene&)>& is_ok,
+                     const std::function<bool()>& within_bound) const;
+    /// Local symmetric Hausdorff distance of layer k around its alive vertex x to the input
+    /// (positions by `at(layer, id)`), scene units.
+    template <typename At>
+    double shape_error(std::size_t k, std::size_t x, At&& at) const;
+    /// The largest shape_error() over the job's free vertices, before it ran or after.
+    double job_shape_error(const Job& job, bool after) const;
+    /// The largest shape_error() over the alive vertices of the job's layers, live positions.
+    double layers_shape_error(const Job& job) const;
     void mark(std::size_t k, std::size_t v, std::vector<std::size_t>& marked,
               const std::vector<Job>& waiting);
     bool is_marked(std::size_t k, std::size_t v) const {

@@ -206,6 +206,7 @@ bool Scheduler::commit(const Job& job) {
     report_.seconds_check += job.result.seconds_check;
     if (job.result.gave_up) ++report_.gave_up;
     if (job.shifted) ++report_.chord_shifts;
+    if (job.shape_refused) ++report_.shape_refused;
     if (!job.result.ok) return false;
     jobs_.apply(job);
     // New costs around the removal and the moved vertices.

@@ -39,6 +39,9 @@ struct Job {
     double seconds_prepare = 0.0;
     bool rolled = false;   ///< Some vertex of the job takes an open layer Flipped (a roll).
     bool shifted = false;  ///< Kept by shifting its chord (JobRunner::shift_chord()), no pass.
+    /// Its untangling succeeded but left the shape farther from the input than allowed
+    /// (JobRunner::execute()): refused.
+    bool shape_refused = false;
 };
 
 /// The job for removing vertex v of layer l, still linked.
