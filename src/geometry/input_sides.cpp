@@ -598,7 +598,8 @@ void match_in_order(const std::vector<Vec2>& points, const std::vector<Vec2>& re
             ordered = match[k] >= lo && match[k] <= hi && (k == j || match[k - 1] <= match[k]);
         if (!ordered && lo <= hi &&
             static_cast<double>(hi - lo + 1) * static_cast<double>(e - j) <= 4e6) {
-            // Candidates per vertex, by reference index; Viterbi over non-decreasing indices.
+            // Candidates per vertex, by reference index; Viterbi over increasing indices (each
+            // vertex of a simplification is a reference vertex of its own, in order).
             struct Cand {
                 std::size_t k;
                 double d, cost;
@@ -618,16 +619,41 @@ void match_in_order(const std::vector<Vec2>& points, const std::vector<Vec2>& re
                     std::nth_element(c.begin(), c.begin() + 16, c.end(),
                                      [](const Cand& x, const Cand& y) { return x.d < y.d; });
                     c.resize(16);
-                    std::sort(c.begin(), c.end(),
-                              [](const Cand& x, const Cand& y) { return x.k < y.k; });
                 }
+                // Each other sheet of the stretch passing near the vertex (a local minimum of
+                // the distance along the reference, beyond the band above): its nearest
+                // vertex and two on either side, so that the order can put the vertex on the
+                // sheet it belongs to even when it moved nearer another one (the end of a
+                // roll pulled toward the layer's main part).
+                std::vector<std::size_t> minima;
+                for (std::size_t k = lo; k <= hi; ++k) {
+                    const double d = distance[k - lo];
+                    if (d > 3.0 * nearest && (k == lo || d <= distance[k - 1 - lo]) &&
+                        (k == hi || d < distance[k + 1 - lo]))
+                        minima.push_back(k);
+                }
+                const std::size_t sheets = std::min<std::size_t>(minima.size(), 4);
+                std::partial_sort(minima.begin(),
+                                  minima.begin() + static_cast<std::ptrdiff_t>(sheets),
+                                  minima.end(), [&](std::size_t x, std::size_t y) {
+                                      return distance[x - lo] < distance[y - lo];
+                                  });
+                for (std::size_t m = 0; m < sheets; ++m)
+                    for (std::size_t k = minima[m] - std::min<std::size_t>(minima[m] - lo, 2);
+                         k <= std::min(hi, minima[m] + 2); ++k)
+                        c.push_back({k, distance[k - lo], detail::kFar, detail::kNoSegment});
+                std::sort(c.begin(), c.end(),
+                          [](const Cand& x, const Cand& y) { return x.k < y.k; });
+                c.erase(std::unique(c.begin(), c.end(),
+                                    [](const Cand& x, const Cand& y) { return x.k == y.k; }),
+                        c.end());
             }
             for (Cand& c : cands[0]) c.cost = c.d;
             for (std::size_t r = 1; r < cands.size(); ++r)
                 for (Cand& c : cands[r])
                     for (std::size_t q = 0; q < cands[r - 1].size(); ++q) {
                         const Cand& p = cands[r - 1][q];
-                        if (p.k <= c.k && p.cost + c.d < c.cost) {
+                        if (p.k < c.k && p.cost + c.d < c.cost) {
                             c.cost = p.cost + c.d;
                             c.from = q;
                         }
@@ -684,7 +710,8 @@ InputSides InputSides::matched(const InputSides& recorded, const Scene& referenc
         // vertex closest to another sheet of a roll, nearer than it moved), the run takes the
         // reference vertices in order, between those of its unmoved ends, that are nearest in
         // all (each vertex choosing among the reference vertices within 3 times its nearest
-        // one's distance; runs whose stretch times length exceeds 4e6 keep their matches).
+        // one's distance and the nearest ones of the 4 nearest other sheets of the stretch;
+        // runs whose stretch times length exceeds 4e6 keep their matches).
         if (!ref_layer.closed) match_in_order(points, ref, exact, match);
         std::vector<std::size_t>& origin = out.origin_[a];
         for (std::size_t k : match) {

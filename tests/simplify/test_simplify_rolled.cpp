@@ -409,6 +409,58 @@ TEST_CASE("sides matched without the correspondence keep a moved vertex on its o
     CHECK(bad.nesting_violation_count > 0);
 }
 
+TEST_CASE("sides matched without the correspondence keep a roll's end on its sheet", "[rolled]") {
+    // The reference of the test above. In the "output" B moved down to y = 0.2, A's lower
+    // sheet to y = -0.1, its bend and upper sheet a little, and the roll's end to (6, 0.4):
+    // still over B, but 4 times nearer the lower sheet's vertex (6, 0) than its own (6, 2),
+    // beyond the band of 3 times the nearest that the in-order matching chose from. Every
+    // vertex but the first moved, so the run's stretch holds both sheets; the order puts the
+    // end after the bend, on the upper sheet: no violation. Before, the upper sheet was no
+    // candidate, the nearest match was kept and the end was judged under B (the shirt at 95%,
+    // seeds 5 and 13, and at 600 points, seed 2: the roll's end moved toward the main part).
+    auto open = [](const char* name, std::vector<Vec2> points) {
+        Layer layer;
+        layer.name = name;
+        layer.points = std::move(points);
+        return layer;
+    };
+    const Layer a = open("a", {{0, 0},
+                               {2, 0},
+                               {4, 0},
+                               {6, 0},
+                               {8, 0},
+                               {10, 0},
+                               {11, 1},
+                               {10, 2},
+                               {9, 2},
+                               {8, 2},
+                               {7, 2},
+                               {6, 2},
+                               {5, 2}});
+    const Layer b = open("b", {{-1, 1}, {1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1}});
+    const Scene reference({a, b});
+    const InputSides recorded = record_input_sides(reference);
+    CheckParams cp;
+    cp.outside_sides = outside_sides(reference);
+    Layer a_out = open("a", {{0, 0}, {4, -0.1}, {8, -0.1}, {11.1, 1}, {10, 2.1}, {6, 0.4}});
+    const Layer b_out = open("b", {{-1, 0.2}, {8.5, 0.2}});
+    const Scene out({a_out, b_out});
+    const InputSides matched = InputSides::matched(recorded, reference, out);
+    cp.input_sides = &matched;
+    const CheckReport ok = check_scene(out, cp);
+    CHECK(ok.crossing_count == 0);
+    CHECK(ok.nesting_violation_count == 0);
+
+    // The roll's end pulled across B, under it: a violation (the nearest match, the lower
+    // sheet's side, hid it before).
+    a_out.points[5] = {6, 0.1};
+    const Scene wrong({a_out, b_out});
+    const InputSides matched_wrong = InputSides::matched(recorded, reference, wrong);
+    cp.input_sides = &matched_wrong;
+    const CheckReport bad = check_scene(wrong, cp);
+    CHECK(bad.nesting_violation_count > 0);
+}
+
 TEST_CASE("an untangling of rolled vertices that stalls gives up (only there)", "[rolled]") {
     // The shirt rolled over a jacket's end, random decimation, immediate schedule. In the
     // rolled scene at 95% (seed 0) one removal cannot be untangled: its job holds rolled

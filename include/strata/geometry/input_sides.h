@@ -64,7 +64,10 @@ class InputSides {
     /// closest segment of its layer's reference nearest to it, except that on an open layer a
     /// run of vertices that moved (not on a reference vertex), between two that did not, whose
     /// matches leave the reference's order (a vertex nearer another sheet of a roll) takes the
-    /// reference vertices in order nearest in all. Layers without a namesake get none.
+    /// reference vertices in order nearest in all, each vertex choosing among those near it on
+    /// every sheet of the stretch that passes near it (so that a vertex moved nearer another
+    /// sheet than its own, such as a roll's end pulled toward the layer's main part, keeps its
+    /// own sheet where the order says so). Layers without a namesake get none.
     static InputSides matched(const InputSides& recorded, const Scene& reference,
                               const Scene& scene);
     /// The same sides made consistent along each layer, for sides recorded in a scene that is
