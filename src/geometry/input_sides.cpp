@@ -648,13 +648,22 @@ void match_in_order(const std::vector<Vec2>& points, const std::vector<Vec2>& re
                                     [](const Cand& x, const Cand& y) { return x.k == y.k; }),
                         c.end());
             }
-            for (Cand& c : cands[0]) c.cost = c.d;
+            // The cost of a match: its distance, plus how differently from the previous vertex
+            // the vertex moved (the untangling moves neighbours alike; on a roll, whose sheets
+            // run opposite ways, a run moved nearer the other sheet keeps its own).
+            auto moved_apart = [&](std::size_t v, std::size_t k, std::size_t pk) {
+                return std::hypot(points[v].x - ref[k].x - (points[v - 1].x - ref[pk].x),
+                                  points[v].y - ref[k].y - (points[v - 1].y - ref[pk].y));
+            };
+            for (Cand& c : cands[0]) c.cost = c.d + (j > 0 ? moved_apart(j, c.k, match[j - 1]) : 0.0);
             for (std::size_t r = 1; r < cands.size(); ++r)
                 for (Cand& c : cands[r])
                     for (std::size_t q = 0; q < cands[r - 1].size(); ++q) {
                         const Cand& p = cands[r - 1][q];
-                        if (p.k < c.k && p.cost + c.d < c.cost) {
-                            c.cost = p.cost + c.d;
+                        if (p.k >= c.k) continue;
+                        const double cost = p.cost + c.d + moved_apart(j + r, c.k, p.k);
+                        if (cost < c.cost) {
+                            c.cost = cost;
                             c.from = q;
                         }
                     }
