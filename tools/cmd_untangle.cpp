@@ -165,7 +165,8 @@ Run add_untangle_command(CLI::App& app) {
                 {"finishes", r.finishes},
                 {"finish_moves", r.finish_moves},
                 {"kept_simple", r.kept_simple},
-                {"long_rounds", r.long_rounds}};
+                {"long_rounds", r.long_rounds},
+                {"more_passes", r.more_passes}};
             if (params.input_sides)
                 j["sides"] = {{"from", reference ? opt->reference : "inferred"},
                               {"rolled_vertices", r.rolled_vertices},

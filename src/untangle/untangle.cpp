@@ -461,24 +461,24 @@ bool has_rolled_regions(const Scene& scene) {
 }
 
 // When the tries with params fail, they run again with long rounds (UntangleParams::
-// long_rounds_factor) and the first clean result is kept; the report counts both. Only where
-// the sides are known (`sides_known`: an original's) or the scene has no rolled regions: where
-// the sides are in question, longer rounds let a wrong reading hold (the collar at 95%, seeds 4
-// and 9, came out clean by the global order with its fold unrolled), and the untangling had
-// better say it failed.
+// long_rounds_factor) and the first clean result is kept; the report counts both. Where the
+// sides are in question (not `sides_known`, an original's, and the scene has rolled regions),
+// the retry takes the inferred sides alone (`tries(scene, params, true)`), which keep the rolled
+// regions: with the global order and the other readings, longer rounds let a wrong reading hold
+// (the collar at 95%, seeds 4 and 9, came out clean by the global order with its fold
+// unrolled), and the untangling had better say it failed.
 template <class Tries>
 UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, bool sides_known,
                                 Tries&& tries) {
     const Scene input = scene;
-    UntangleReport report = tries(scene, params);
-    if (report.collision_free || params.long_rounds_factor <= 1 ||
-        (!sides_known && has_rolled_regions(input)))
-        return report;
+    UntangleReport report = tries(scene, params, false);
+    if (report.collision_free || params.long_rounds_factor <= 1) return report;
+    const bool in_question = !sides_known && has_rolled_regions(input);
     UntangleParams longer = params;
     longer.gradient_steps = params.gradient_steps * params.long_rounds_factor;
     longer.long_rounds_factor = 1;
     Scene attempt = input;
-    UntangleReport second = tries(attempt, longer);
+    UntangleReport second = tries(attempt, longer, in_question);
     TriesCost cost;
     cost.add(report);
     cost.add(second);
@@ -506,8 +506,11 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
     return cost.charged_to(second);
 }
 
+// `inferred_only`: the tries by the inferred sides alone, when they have rolled regions (a
+// failed report otherwise); no global order, no other reading.
 UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
-                                     const ProgressFn& progress, InputSides* kept) {
+                                     const ProgressFn& progress, InputSides* kept,
+                                     bool inferred_only) {
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
     const InputSides recorded = record_input_sides(scene);
@@ -532,6 +535,19 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
         cost.add(report);
         return report.collision_free;
     };
+    if (inferred_only) {
+        UntangleReport report;
+        if (!rolled) return report;
+        for (bool keep_simple : {false, true}) {
+            Scene attempt;
+            if (!clean_try(with_sides, keep_simple, attempt, report)) continue;
+            report.inferred_sides = true;
+            if (kept) *kept = std::move(inferred);
+            scene = std::move(attempt);
+            return cost.charged_to(report);
+        }
+        return cost.charged_to(report);
+    }
     for (bool keep_simple : {false, true}) {
         Scene attempt;
         UntangleReport report;
@@ -599,12 +615,31 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
                                         const ProgressFn& progress, InputSides* kept) {
     if (params.input_sides && !params.input_sides->empty())
-        return with_long_rounds(scene, params, true, [&](Scene& s, const UntangleParams& p) {
-            return untangle_tries(s, p, progress);
+        return with_long_rounds(scene, params, true,
+                                [&](Scene& s, const UntangleParams& p, bool /*in_question*/) {
+                                    return untangle_tries(s, p, progress);
+                                });
+    const Scene input = scene;
+    UntangleReport report = with_long_rounds(
+        scene, params, false, [&](Scene& s, const UntangleParams& p, bool in_question) {
+            return inferring_sides_tries(s, p, progress, kept, in_question);
         });
-    return with_long_rounds(scene, params, false, [&](Scene& s, const UntangleParams& p) {
-        return inferring_sides_tries(s, p, progress, kept);
-    });
+    // Every try failed: where the global order is the reading (nothing read rolled), its second
+    // try (no self-crossing made) once more with more passes: the projection of a fold cut by
+    // chords can wander for a few hundred passes before it comes out clean.
+    if (report.collision_free || params.more_passes_factor <= 1 || has_rolled_regions(input))
+        return report;
+    UntangleParams more = with_outside_sides(input, params);
+    more.max_passes = params.max_passes * params.more_passes_factor;
+    Scene attempt = input;
+    UntangleReport last = untangle_once(attempt, more, progress, true);
+    TriesCost cost;
+    cost.add(report);
+    cost.add(last);
+    if (!last.collision_free) return cost.charged_to(report);
+    scene = std::move(attempt);
+    last.more_passes = true;
+    return cost.charged_to(last);
 }
 
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,

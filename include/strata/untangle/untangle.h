@@ -88,11 +88,19 @@ struct UntangleParams {
     /// run once more from the input with gradient_steps x this factor (rounds this many times
     /// longer, so shape matching, which pulls toward the tangled input, comes this many times
     /// less often per projection step); the first clean result of those is kept. <= 1: no such
-    /// retry. A scene that an earlier try cleans never gets here (its output is unchanged),
-    /// nor one with rolled regions by its inferred sides (where the sides are in question,
-    /// longer rounds let a wrong reading hold). untangle() itself does not retry. docs/untangle.md,
+    /// retry. A scene that an earlier try cleans never gets here (its output is unchanged). A
+    /// scene with rolled regions by its inferred sides retries by those sides alone, which keep
+    /// the rolls (where the sides are in question, longer rounds by the global order or another
+    /// reading let a wrong reading hold). untangle() itself does not retry. docs/untangle.md,
     /// "Longer rounds when every try fails".
     int long_rounds_factor = 3;
+    /// untangle_inferring_sides() without params.input_sides only, for a scene without rolled
+    /// regions by its inferred sides (the global order is its reading): when every try has
+    /// failed, long rounds included, the global order's second try (no self-crossing made) runs
+    /// once more from the input with max_passes x this factor (the projection of a fold cut by
+    /// chords wanders for a while before it comes out clean). <= 1: no such retry.
+    /// docs/untangle.md, "More passes when every try fails".
+    int more_passes_factor = 4;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
     /// queries as fast (docs/field.md, README "Benchmarks").
@@ -170,6 +178,9 @@ struct UntangleReport {
     /// untangle_inferring_sides(): every try with params.gradient_steps failed, and the result
     /// is that of the retry with params.long_rounds_factor times as many.
     bool long_rounds = false;
+    /// untangle_inferring_sides(): every try failed, long rounds included, and the result is
+    /// the global order's second try with params.more_passes_factor times the passes.
+    bool more_passes = false;
 };
 
 /// @brief The outside sides untangle() and untangle_inferring_sides() take when
@@ -219,11 +230,13 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// other side), first as untangle()'s first try, then as its second; the first round with a clean
 /// result keeps the clean one that moves a vertex least (report.inferred_sides, `kept` those
 /// sides). When every try fails, they all run once more with params.long_rounds_factor times the
-/// gradient steps (report.long_rounds). With params.input_sides given (an original's sides, not
-/// in question), untangle(), and when it fails once more with the long rounds. Same
-/// params, progress and throws as untangle(). `kept`: if given, receives the inferred sides when
-/// they were kept, for judging the result (check_scene() with them and params' outside sides, or
-/// outside_sides() of the input); left alone otherwise.
+/// gradient steps (report.long_rounds; where the inferred sides have rolled regions, those sides
+/// alone); when those fail too and nothing is read rolled, the global order's second try with
+/// params.more_passes_factor times the passes (report.more_passes). With params.input_sides given
+/// (an original's sides, not in question), untangle(), and when it fails once more with the long
+/// rounds. Same params, progress and throws as untangle(). `kept`: if given, receives the inferred
+/// sides when they were kept, for judging the result (check_scene() with them and params' outside
+/// sides, or outside_sides() of the input); left alone otherwise.
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params = {},
                                         const ProgressFn& progress = {},
                                         InputSides* kept = nullptr);
