@@ -385,8 +385,20 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     const std::vector<std::size_t>& turn = turns_of();
                     std::vector<int> part(n, 0);  // the number of turns before, modulo 2
                     std::size_t even = 0, odd = 0;
+                    // The first vertex after each turn: the one after the turn vertex, or the
+                    // turn vertex itself where the segment that reaches it meets b (the bend
+                    // cut across b: that segment is the tangle, and the turn vertex lies on
+                    // the side of the part after it, joined to it by a segment that does not
+                    // meet b).
+                    std::vector<std::size_t> after;
+                    for (const std::size_t k : turn)
+                        after.push_back(
+                            meets(layer.points[k - 1], layer.points[k], scene.layer(b)) &&
+                                    !meets(layer.points[k], layer.points[k + 1], scene.layer(b))
+                                ? k
+                                : k + 1);
                     for (std::size_t k = 0, t = 0; k < n; ++k) {
-                        while (t < turn.size() && turn[t] < k) ++t;
+                        while (t < after.size() && after[t] <= k) ++t;
                         part[k] = static_cast<int>(t % 2);
                         if (recorded[k] == 1 || recorded[k] == -1) ++(t % 2 == 0 ? even : odd);
                     }
