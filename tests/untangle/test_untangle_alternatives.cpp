@@ -516,3 +516,29 @@ TEST_CASE("by_region: a turn vertex reached by a chord across the other layer li
     CHECK(check.is_collision_free());
     CHECK(check.nesting_violation_count == 0);
 }
+
+TEST_CASE("untangling_outside_sides: a body's centroid is its area's, not its vertices'",
+          "[untangle][sides]") {
+    // The collar at 95%, seed 28 of bench/out_of_sample.sh: the decimation kept the body's
+    // vertices mostly on its upper left (vertex centroid (-0.39, 0.29) of a body of radius 1
+    // centred at the origin) and a collar chord across the body. Seen from the vertex centroid
+    // the collar sweeps -117 degrees (the rule of a third of a turn does not apply, and the
+    // collar's vote, inside out, stood: the body read rolled over it held, `strata untangle`
+    // exiting 0 dirty by the original's sides); from the area's centroid (-0.09, 0.04), +209.
+    const Scene input = make_scene(SceneFamily::CollarWrap);
+    const Scene tangled = naive_decimation(input, 0.95, 28);
+    const std::size_t collar = tangled.size() - 1;
+    REQUIRE(!tangled.layer(collar).closed);
+    const std::vector<int> original = outside_sides(input);
+    REQUIRE(outside_sides(tangled)[collar] != original[collar]);  // the vote, inside out
+    CHECK(untangling_outside_sides(tangled)[collar] == original[collar]);
+    const InputSides sides = InputSides::matched(record_input_sides(input), input, tangled);
+    CheckParams scoring;
+    scoring.outside_sides = original;
+    scoring.input_sides = &sides;
+    Scene out = tangled;
+    CHECK(untangle_inferring_sides(out).collision_free);
+    const CheckReport check = check_scene(out, scoring);
+    CHECK(check.is_collision_free());
+    CHECK(check.nesting_violation_count == 0);
+}

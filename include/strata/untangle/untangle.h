@@ -186,7 +186,8 @@ struct UntangleReport {
 /// @brief The outside sides untangle() and untangle_inferring_sides() take when
 /// params.outside_sides is empty (`strata untangle` judges its result by them too):
 /// outside_side() of every layer, made consistent where a tangle split the votes. An open
-/// layer directly over a closed one whose vertex centroid lies inside it, and that runs around
+/// layer directly over a closed one whose centroid (of its polygon's area, not of its vertices,
+/// which a decimation can leave on one side) lies inside it, and that runs around
 /// that centroid (the mean over its segments, weighted by length, of the sine between the
 /// segment and the direction from the centroid beyond 0.8 either way), faces away from it (+1
 /// counter-clockwise), whatever its vote (a tangled body's vertices can outvote it). One that
