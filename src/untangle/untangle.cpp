@@ -464,6 +464,19 @@ struct TriesCost {
     }
 };
 
+// After a failed try (`failed`, whose result `scene` holds), another one from the input
+// (`second`, its result in `attempt`): the second result is kept when clean, the first stands
+// otherwise; the report counts both.
+UntangleReport after_retry(Scene& scene, const UntangleReport& failed, Scene&& attempt,
+                           const UntangleReport& second) {
+    TriesCost cost;
+    cost.add(failed);
+    cost.add(second);
+    if (!second.collision_free) return cost.charged_to(failed);
+    scene = std::move(attempt);
+    return cost.charged_to(second);
+}
+
 }  // namespace
 
 namespace {
@@ -494,13 +507,8 @@ UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, bool
     longer.long_rounds_factor = 1;
     Scene attempt = input;
     UntangleReport second = tries(attempt, longer, in_question);
-    TriesCost cost;
-    cost.add(report);
-    cost.add(second);
-    if (!second.collision_free) return cost.charged_to(report);
-    scene = std::move(attempt);
     second.long_rounds = true;
-    return cost.charged_to(second);
+    return after_retry(scene, report, std::move(attempt), second);
 }
 
 UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
@@ -512,13 +520,8 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
     // Second try, from the input: no vertex move that makes a self-crossing (the projection
     // and shape matching make them, and nothing takes them out: docs/untangle.md).
     Scene simple = input;
-    UntangleReport second = untangle_once(simple, params, progress, true);
-    TriesCost cost;
-    cost.add(report);
-    cost.add(second);
-    if (!second.collision_free) return cost.charged_to(report);
-    scene = std::move(simple);
-    return cost.charged_to(second);
+    const UntangleReport second = untangle_once(simple, params, progress, true);
+    return after_retry(scene, report, std::move(simple), second);
 }
 
 // `inferred_only`: the tries by the inferred sides alone, when they have rolled regions (a
@@ -648,13 +651,8 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     more.max_passes = params.max_passes * params.more_passes_factor;
     Scene attempt = input;
     UntangleReport last = untangle_once(attempt, more, progress, true);
-    TriesCost cost;
-    cost.add(report);
-    cost.add(last);
-    if (!last.collision_free) return cost.charged_to(report);
-    scene = std::move(attempt);
     last.more_passes = true;
-    return cost.charged_to(last);
+    return after_retry(scene, report, std::move(attempt), last);
 }
 
 UntangleReport untangle_local(Scene& scene, const Box2& box, std::size_t n_out,
