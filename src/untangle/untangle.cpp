@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -464,6 +465,12 @@ struct TriesCost {
     }
 };
 
+// a x b for positive counts, at most INT_MAX (a pass cap or a step count a user made large).
+int saturated_product(int a, int b) {
+    const long long product = static_cast<long long>(a) * static_cast<long long>(b);
+    return static_cast<int>(std::min<long long>(product, std::numeric_limits<int>::max()));
+}
+
 // After a failed try (`failed`, whose result `scene` holds), another one from the input
 // (`second`, its result in `attempt`): the second result is kept when clean, the first stands
 // otherwise; the report counts both.
@@ -503,7 +510,7 @@ UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, bool
     if (report.collision_free || params.long_rounds_factor <= 1) return report;
     const bool in_question = !sides_known && has_rolled_regions(input);
     UntangleParams longer = params;
-    longer.gradient_steps = params.gradient_steps * params.long_rounds_factor;
+    longer.gradient_steps = saturated_product(params.gradient_steps, params.long_rounds_factor);
     longer.long_rounds_factor = 1;
     Scene attempt = input;
     UntangleReport second = tries(attempt, longer, in_question);
@@ -648,7 +655,7 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     if (report.collision_free || params.more_passes_factor <= 1 || has_rolled_regions(input))
         return report;
     UntangleParams more = with_outside_sides(input, params);
-    more.max_passes = params.max_passes * params.more_passes_factor;
+    more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
     Scene attempt = input;
     UntangleReport last = untangle_once(attempt, more, progress, true);
     last.more_passes = true;
