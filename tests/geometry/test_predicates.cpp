@@ -260,3 +260,25 @@ TEST_CASE("winding_change_across gives the winding change along a path", "[predi
     CHECK(decided > 3900);
     CHECK(changed > 400);  // the identity is tested where the winding number changes, too
 }
+
+TEST_CASE("point_in_closed_triangle: closed, exact, and flat triangles by their box",
+          "[predicates]") {
+    auto in = [](const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
+        Box2 box;
+        box.extend(a);
+        box.extend(b);
+        box.extend(c);
+        return point_in_closed_triangle(box, a, b, c, p);
+    };
+    const Vec2 a(0, 0), b(4, 0), c(0, 4);
+    CHECK(in(a, b, c, {1, 1}));
+    CHECK(in(c, b, a, {1, 1}));  // either orientation
+    CHECK(in(a, b, c, {2, 2}));  // on the hypotenuse
+    CHECK(in(a, b, c, a));       // a corner
+    CHECK_FALSE(in(a, b, c, {2.0, 2.0 + 1e-15}));
+    CHECK_FALSE(in(a, b, c, {-1e-300, 1}));
+    // A flat triangle holds its segment, not the rest of its line.
+    CHECK(in(a, {2, 2}, {4, 4}, {3, 3}));
+    CHECK_FALSE(in(a, {2, 2}, {4, 4}, {5, 5}));
+    CHECK_FALSE(in(a, {2, 2}, {4, 4}, {3, 3.5}));
+}

@@ -100,4 +100,15 @@ inline double point_segment_distance(const Vec2& p, const Vec2& a, const Vec2& b
     return std::sqrt(dx * dx + dy * dy);
 }
 
+/// p lies in the closed triangle (a, b, c), exactly. The box test comes first: it is exact,
+/// rejects most points without a predicate, and is what decides for a flat triangle (collinear
+/// a, b, c), where every point of the line through them has three zero orientations.
+/// `box`: the box of a, b and c (a caller testing many points computes it once).
+inline bool point_in_closed_triangle(const Box2& box, const Vec2& a, const Vec2& b, const Vec2& c,
+                                     const Vec2& p) {
+    if (!box.contains(p)) return false;
+    const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
+    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+}
+
 }  // namespace strata

@@ -460,13 +460,11 @@ bool JobRunner::shift_chord(Job& job, const std::function<bool(const Scene&)>& i
         for (const Vec2& p : {before, pa, pb, after, qa, qb}) swept.extend(p);
         bool clear = true;
         auto in = [](const Vec2& x, const Vec2& p, const Vec2& q, const Vec2& r) {
-            Box2 box;  // exact, and what decides for a flat triangle
+            Box2 box;
             box.extend(p);
             box.extend(q);
             box.extend(r);
-            if (!box.contains(x)) return false;
-            const int o1 = orient2d(p, q, x), o2 = orient2d(q, r, x), o3 = orient2d(r, p, x);
-            return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
+            return point_in_closed_triangle(box, p, q, r, x);
         };
         live_.live_segments_near(swept, [&](const LiveSegment& s) {
             if (!clear) return;

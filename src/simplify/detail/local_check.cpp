@@ -11,17 +11,6 @@ namespace strata::detail {
 
 namespace {
 
-// p lies in the closed triangle (a, b, c). The box test first: it is exact, rejects most
-// points without a predicate, and is what decides for a flat triangle (collinear a, b, c),
-// where every point of the line through them has three zero orientations.
-// `box`: the box of a, b and c.
-bool point_in_closed_triangle(const Box2& box, const Vec2& a, const Vec2& b, const Vec2& c,
-                              const Vec2& p) {
-    if (!box.contains(p)) return false;
-    const int o1 = orient2d(a, b, p), o2 = orient2d(b, c, p), o3 = orient2d(c, a, p);
-    return (o1 >= 0 && o2 >= 0 && o3 >= 0) || (o1 <= 0 && o2 <= 0 && o3 <= 0);
-}
-
 double segment_distance(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1) {
     return std::min(
         std::min(point_segment_distance(p0, q0, q1), point_segment_distance(p1, q0, q1)),
