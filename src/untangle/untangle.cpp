@@ -497,18 +497,19 @@ bool has_rolled_regions(const Scene& scene) {
 
 // When the tries with params fail, they run again with long rounds (UntangleParams::
 // long_rounds_factor) and the first clean result is kept; the report counts both. Where the
-// sides are in question (not `sides_known`, an original's, and the scene has rolled regions),
-// the retry takes the inferred sides alone (`tries(scene, params, true)`), which keep the rolled
-// regions: with the global order and the other readings, longer rounds let a wrong reading hold
-// (the collar at 95%, seeds 4 and 9, came out clean by the global order with its fold
-// unrolled), and the untangling had better say it failed.
-template <class Tries>
-UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, bool sides_known,
-                                Tries&& tries) {
+// sides are in question (`in_question()`: not an original's, and the scene has rolled regions;
+// asked only when the tries failed), the retry takes the inferred sides alone
+// (`tries(scene, params, true)`), which keep the rolled regions: with the global order and the
+// other readings, longer rounds let a wrong reading hold (the collar at 95%, seeds 4 and 9,
+// came out clean by the global order with its fold unrolled), and the untangling had better
+// say it failed.
+template <class Tries, class InQuestion>
+UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params,
+                                InQuestion&& in_question_of, Tries&& tries) {
     const Scene input = scene;
     UntangleReport report = tries(scene, params, false);
     if (report.collision_free || params.long_rounds_factor <= 1) return report;
-    const bool in_question = !sides_known && has_rolled_regions(input);
+    const bool in_question = in_question_of(input);
     UntangleParams longer = params;
     longer.gradient_steps = saturated_product(params.gradient_steps, params.long_rounds_factor);
     longer.long_rounds_factor = 1;
@@ -640,19 +641,26 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
                                         const ProgressFn& progress, InputSides* kept) {
     if (params.input_sides && !params.input_sides->empty())
-        return with_long_rounds(scene, params, true,
-                                [&](Scene& s, const UntangleParams& p, bool /*in_question*/) {
-                                    return untangle_tries(s, p, progress);
-                                });
+        return with_long_rounds(
+            scene, params, [](const Scene&) { return false; },  // the original's: not in question
+            [&](Scene& s, const UntangleParams& p, bool /*in_question*/) {
+                return untangle_tries(s, p, progress);
+            });
     const Scene input = scene;
+    // has_rolled_regions(input), once, when a retry first asks.
+    std::optional<bool> rolled;
+    auto rolled_regions = [&](const Scene& s) {
+        if (!rolled) rolled = has_rolled_regions(s);
+        return *rolled;
+    };
     UntangleReport report = with_long_rounds(
-        scene, params, false, [&](Scene& s, const UntangleParams& p, bool in_question) {
+        scene, params, rolled_regions, [&](Scene& s, const UntangleParams& p, bool in_question) {
             return inferring_sides_tries(s, p, progress, kept, in_question);
         });
     // Every try failed: where the global order is the reading (nothing read rolled), its second
     // try (no self-crossing made) once more with more passes: the projection of a fold cut by
     // chords can wander for a few hundred passes before it comes out clean.
-    if (report.collision_free || params.more_passes_factor <= 1 || has_rolled_regions(input))
+    if (report.collision_free || params.more_passes_factor <= 1 || rolled_regions(input))
         return report;
     UntangleParams more = with_outside_sides(input, params);
     more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
