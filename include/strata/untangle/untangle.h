@@ -67,8 +67,8 @@ struct UntangleParams {
     /// (separation_tolerance x the smallest required separation of the constrained pairs).
     /// Never when a constrained pair requires less than min_separation (zero thickness: only
     /// crossings fail, and the violation does not tell). The untangling then ends as not
-    /// collision-free. false: every pass runs. simplify()'s default_untangling() turns it on
-    /// (docs/simplify.md).
+    /// collision-free. false: every pass runs. simplify() leaves it off, but its untanglings of
+    /// rolled vertices give up this way (docs/simplify.md).
     bool give_up_when_stalled = false;
     /// Finishing stage: before every check, the layers still closer than the gap aimed for
     /// (max(required, min_separation)) are pushed apart exactly on the polylines, by
@@ -83,8 +83,8 @@ struct UntangleParams {
     /// attempt of its own left, e.g. strata simplify's untangling of a crossing input with
     /// the gap rule before the one without it).
     std::size_t other_readings = 4;
-    /// untangle_inferring_sides() without params.input_sides only: when every try fails
-    /// (inferred sides, global order, other readings; first and second tries), all of them
+    /// untangle_inferring_sides() only: when every try fails (without params.input_sides:
+    /// inferred sides, global order, other readings; first and second tries), all of them
     /// run once more from the input with gradient_steps x this factor (rounds this many times
     /// longer, so shape matching, which pulls toward the tangled input, comes this many times
     /// less often per projection step); the first clean result of those is kept. <= 1: no such
@@ -192,10 +192,10 @@ struct UntangleReport {
 /// segment and the direction from the centroid beyond 0.8 either way), faces away from it (+1
 /// counter-clockwise), whatever its vote (a tangled body's vertices can outvote it). One that
 /// runs back in part (a fold at its end: the mean sine fails) faces away from the largest such
-/// closed layer directly under it (bounding-box diagonal) when it sweeps around its centroid by
-/// at least 120 degrees (the signed angles its segments subtend from there). Two directly
-/// related open layers that run along each other (the mean cosine of their tangents at 64
-/// evenly spaced fractions of their lengths beyond 0.8 either way) must have the same outside
+/// closed layer under it, directly or with layers between (bounding-box diagonal), when it sweeps
+/// around its centroid by at least 120 degrees (the signed angles its segments subtend from there).
+/// Two directly related open layers that run along each other (the mean cosine of their tangents at
+/// 64 evenly spaced fractions of their lengths beyond 0.8 either way) must have the same outside
 /// side when they travel the same way and opposite ones otherwise. Where the votes of a chain
 /// of such layers disagree (in a scene tangled by decimation, a layer's vote counts the
 /// neighbours' vertices scattered on both sides of it), every layer of the chain takes the
