@@ -1,6 +1,7 @@
 #include "cli_util.h"
 
 #include "strata/core/error.h"
+#include "strata/core/format.h"
 #include "strata/geometry/predicates.h"
 #include "strata/io/atomic_file.h"
 
@@ -8,10 +9,15 @@
 
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <string>
 
 namespace strata::cli {
+
+std::string shown_name(std::string_view name) {
+    return shown_text(name, std::numeric_limits<std::size_t>::max());
+}
 
 ProgressFn terminal_progress() {
     if (!isatty(fileno(stderr))) return {};

@@ -12,9 +12,15 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace strata::cli {
+
+/// A name or other text read from an input file (a layer name, the units) as a report line
+/// shows it: shown_text() in full, never cut, so that a control byte or broken UTF-8 in it
+/// can neither move the cursor, colour nor garble the terminal (\xNN, a backslash as \\).
+std::string shown_name(std::string_view name);
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; never cancels.
 ProgressFn terminal_progress();

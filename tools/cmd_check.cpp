@@ -1,4 +1,5 @@
 // strata check: exact collision checks of a scene, as a table or JSON.
+#include "cli_util.h"
 #include "commands.h"
 #include "reference.h"
 
@@ -123,18 +124,19 @@ nlohmann::json to_json(const Scene& scene, const CheckReport& r,
 
 void print_table(const std::string& input, const Scene& scene, const CheckReport& r,
                  const std::vector<std::optional<HausdorffDistance>>& h, bool ok) {
+    // Names and units come from the file: shown with their control bytes escaped.
     std::printf("%s: %zu layers, %zu vertices%s%s\n", input.c_str(), scene.size(),
                 scene.vertex_count(), scene.units().empty() ? "" : ", units ",
-                scene.units().c_str());
+                shown_name(scene.units()).c_str());
     std::printf("  %-20s %-6s %8s %10s %6s%s\n", "layer", "closed", "vertices", "thickness",
                 "self-x", h.empty() ? "" : "  hausdorff(ref)");
     for (std::size_t i = 0; i < scene.size(); ++i) {
         const Layer& l = scene.layer(i);
         std::string hd =
             h.empty() ? "" : (h[i] ? "  " + num(h[i]->symmetric()) : "  (not in reference)");
-        std::printf("  %-20s %-6s %8zu %10s %6zu%s\n", l.name.c_str(), l.closed ? "yes" : "no",
-                    l.points.size(), num(l.thickness).c_str(), r.self_crossing_count[i],
-                    hd.c_str());
+        std::printf("  %-20s %-6s %8zu %10s %6zu%s\n", shown_name(l.name).c_str(),
+                    l.closed ? "yes" : "no", l.points.size(), num(l.thickness).c_str(),
+                    r.self_crossing_count[i], hd.c_str());
     }
     std::printf("crossings between layers: %zu (%zu proper, %zu touching)\n", r.crossing_count,
                 r.crossing_count - r.touch_count, r.touch_count);
@@ -142,8 +144,8 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
         const Crossing& c = r.crossings[k];
         std::printf("  %s at (%s, %s): '%s' segment %zu x '%s' segment %zu\n",
                     c.is_touch ? "touch" : "cross", num(c.point.x).c_str(), num(c.point.y).c_str(),
-                    scene.layer(c.layer_a).name.c_str(), c.segment_a,
-                    scene.layer(c.layer_b).name.c_str(), c.segment_b);
+                    shown_name(scene.layer(c.layer_a).name).c_str(), c.segment_a,
+                    shown_name(scene.layer(c.layer_b).name).c_str(), c.segment_b);
     }
     if (r.crossing_count > 10) std::printf("  ... (--json lists up to %zu)\n", r.crossings.size());
     std::printf("self-crossings: %zu\n", r.total_self_crossings());
@@ -152,8 +154,9 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
         std::printf("  %-20s %-20s %-12s %12s %12s %8s\n", "layer a", "layer b", "relation", "gap",
                     "required", "ratio");
     for (const PairSeparation& p : r.pairs)
-        std::printf("  %-20s %-20s %-12s %12s %12s %8s\n", scene.layer(p.layer_a).name.c_str(),
-                    scene.layer(p.layer_b).name.c_str(), relation_name(p.relation),
+        std::printf("  %-20s %-20s %-12s %12s %12s %8s\n",
+                    shown_name(scene.layer(p.layer_a).name).c_str(),
+                    shown_name(scene.layer(p.layer_b).name).c_str(), relation_name(p.relation),
                     num(p.gap).c_str(), num(p.required).c_str(), num(p.ratio()).c_str());
     std::printf("min separation ratio: %s; vertices closer than required: %zu\n",
                 num(r.min_separation_ratio).c_str(), r.separation_violation_count);

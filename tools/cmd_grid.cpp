@@ -1,6 +1,7 @@
 // `strata grid`: builds the per-layer fields of a scene and writes them for inspection: a .vdb
 // file (one grid per layer), a PNG heat map, or a per-layer summary.
 
+#include "cli_util.h"
 #include "commands.h"
 
 #include "strata/core/error.h"
@@ -138,7 +139,9 @@ Run add_grid_command(CLI::App& app) {
             std::size_t layer = 0;
             if (!opt->layer.empty()) {
                 const auto found = scene.find(opt->layer);
-                if (!found) throw InvalidInput("strata grid: no layer named '" + opt->layer + "'");
+                if (!found)
+                    throw InvalidInput("strata grid: no layer named '" + shown_text(opt->layer) +
+                                       "'");
                 layer = *found;
             }
             write_png(scene, fields, layer, opt->width, opt->png);
@@ -146,10 +149,10 @@ Run add_grid_command(CLI::App& app) {
         if (opt->info) {
             std::cout << "voxel size " << format_number(fields.params().voxel_size) << ", band "
                       << format_number(fields.params().band_width) << " (scene units"
-                      << (scene.units().empty() ? "" : ": " + scene.units()) << ")\n";
+                      << (scene.units().empty() ? "" : ": " + shown_name(scene.units())) << ")\n";
             for (std::size_t i = 0; i < fields.size(); ++i) {
                 const FieldStats st = fields.field(i).stats();
-                std::cout << scene.layer(i).name << ": " << st.segments << " segments, "
+                std::cout << shown_name(scene.layer(i).name) << ": " << st.segments << " segments, "
                           << st.active_voxels << " active voxels, " << st.leaves << " leaves, "
                           << st.memory_bytes << " bytes ("
                           << st.memory_bytes / std::max<std::size_t>(st.segments, 1)

@@ -36,8 +36,8 @@ void print_summary(const std::string& name, const SimplifyReport& r, const Simpl
     std::printf("%-22s %8s %8s %8s %8s %9s %12s\n", "layer", "before", "after", "target", "refused",
                 "untangled", "hausdorff");
     for (const LayerSimplifyReport& l : r.layers)
-        std::printf("%-22s %8zu %8zu %8zu %8zu %9zu %12.4g\n", l.name.c_str(), l.before, l.after,
-                    l.target, l.refused, l.untangled, l.hausdorff);
+        std::printf("%-22s %8zu %8zu %8zu %8zu %9zu %12.4g\n", shown_name(l.name).c_str(), l.before,
+                    l.after, l.target, l.refused, l.untangled, l.hausdorff);
     std::size_t before = 0, after = 0;
     for (const LayerSimplifyReport& l : r.layers) {
         before += l.before;

@@ -214,7 +214,7 @@ Run add_slice_command(CLI::App& app) {
             crossing += crosses ? 1 : 0;
             std::string misses;
             for (const std::string& m : s.missed_meshes)
-                misses += (misses.empty() ? " (misses " : ", ") + m;
+                misses += (misses.empty() ? " (misses " : ", ") + shown_name(m);
             if (!misses.empty()) misses += ")";
             std::printf(
                 "%s: %zu layers (%zu closed, %zu open), %zu vertices, %zu nesting links, "
@@ -227,7 +227,7 @@ Run add_slice_command(CLI::App& app) {
             if (!s.welded.empty()) {
                 std::string welds;
                 for (const WeldedLayer& w : s.welded)
-                    welds += (welds.empty() ? "" : ", ") + w.name + " (" +
+                    welds += (welds.empty() ? "" : ", ") + shown_name(w.name) + " (" +
                              std::to_string(w.pieces) + (w.pieces == 1 ? " piece" : " pieces") +
                              (w.overlaps > 0 ? ", " + std::to_string(w.overlaps) + " overlapping"
                                              : std::string()) +

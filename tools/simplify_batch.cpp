@@ -111,26 +111,27 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
                        std::to_string(check.nesting_violation_count) + " nesting violations";
     if (!check.crossings.empty()) {
         const Crossing& c = check.crossings.front();
-        text += "; first: layer '" + scene.layer(c.layer_a).name + "' segment " +
-                std::to_string(c.segment_a) + " x layer '" + scene.layer(c.layer_b).name +
-                "' segment " + std::to_string(c.segment_b) + " at (" + format_number(c.point.x) +
-                ", " + format_number(c.point.y) + ")";
+        text += "; first: layer '" + shown_text(scene.layer(c.layer_a).name) + "' segment " +
+                std::to_string(c.segment_a) + " x layer '" +
+                shown_text(scene.layer(c.layer_b).name) + "' segment " +
+                std::to_string(c.segment_b) + " at (" + format_number(c.point.x) + ", " +
+                format_number(c.point.y) + ")";
     } else if (!check.self_crossings.empty()) {
         const Crossing& c = check.self_crossings.front();
         const Layer& layer = scene.layer(c.layer_a);
         if (layer.closed && is_flat(layer.points)) {
-            text += "; first: layer '" + layer.name +
+            text += "; first: layer '" + shown_text(layer.name) +
                     "' is flat: all its points are collinear (a closed layer needs an area)";
             return text;
         }
-        text += "; first: layer '" + scene.layer(c.layer_a).name + "' crosses itself (segments " +
+        text += "; first: layer '" + shown_text(layer.name) + "' crosses itself (segments " +
                 std::to_string(c.segment_a) + " and " + std::to_string(c.segment_b) + " at (" +
                 format_number(c.point.x) + ", " + format_number(c.point.y) + "))";
     } else if (!check.nesting_violations.empty()) {
         const NestingViolation& v = check.nesting_violations.front();
-        text += "; first: layer '" + scene.layer(v.layer).name + "' point " +
+        text += "; first: layer '" + shown_text(scene.layer(v.layer).name) + "' point " +
                 std::to_string(v.vertex) + " on the wrong side of layer '" +
-                scene.layer(v.other).name + "'";
+                shown_text(scene.layer(v.other).name) + "'";
     }
     return text;
 }

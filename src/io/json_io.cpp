@@ -589,10 +589,11 @@ class Reader {
     Scene finish(std::vector<Layer> parsed, const std::string& units,
                  std::map<std::string, std::string> metadata) const {
         std::vector<std::string> kept;
-        for (const auto& [key, value] : metadata) kept.push_back("\"" + key + "\"");
+        // Keys and names from the file: shown with their control bytes escaped.
+        for (const auto& [key, value] : metadata) kept.push_back("\"" + shown_text(key) + "\"");
         for (const Layer& l : parsed)
             for (const auto& [key, value] : l.extra)
-                kept.push_back("'" + l.name + "'.\"" + key + "\"");
+                kept.push_back("'" + shown_text(l.name) + "'.\"" + shown_text(key) + "\"");
 
         Scene scene;
         try {
