@@ -6,6 +6,7 @@
 #include "strata/io/atomic_file.h"
 
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -17,6 +18,10 @@ namespace strata::cli {
 
 std::string shown_name(std::string_view name) {
     return shown_text(name, std::numeric_limits<std::size_t>::max());
+}
+
+std::string json_report_text(const nlohmann::json& report) {
+    return report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 ProgressFn terminal_progress() {

@@ -7,6 +7,7 @@
 #include "strata/geometry/scene.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include <cctype>
 #include <filesystem>
@@ -21,6 +22,11 @@ namespace strata::cli {
 /// shows it: shown_text() in full, never cut, so that a control byte or broken UTF-8 in it
 /// can neither move the cursor, colour nor garble the terminal (\xNN, a backslash as \\).
 std::string shown_name(std::string_view name);
+
+/// `report` as the text of a JSON report (2-space indent). A name that is not UTF-8 (an SVG id
+/// can hold any byte; JSON holds UTF-8 only) has its stray bytes replaced by U+FFFD, where
+/// nlohmann's dump() would throw.
+std::string json_report_text(const nlohmann::json& report);
 
 /// A progress bar on stderr, drawn only when stderr is a terminal; never cancels.
 ProgressFn terminal_progress();

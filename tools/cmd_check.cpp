@@ -222,7 +222,7 @@ Run add_check_command(CLI::App& app) {
             nlohmann::json out = to_json(scene, report, h, ok);
             // Rolled or folded-over vertices of the reference (their own side kept), if any.
             if (rolled > 0) out["reference_rolled_vertices"] = rolled;
-            std::cout << out.dump(2) << '\n';
+            std::cout << json_report_text(out) << '\n';
         } else {
             print_table(opt->input, scene, report, h, ok);
             if (rolled > 0)

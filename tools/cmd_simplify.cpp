@@ -112,7 +112,7 @@ int run_demo(const SimplifyOptions& opt) {
             svg));
     nlohmann::json j = report_json(*o.report, &*o.naive);
     j["peak_memory_mib"] = peak_memory_mib();
-    write_file_atomic(dir / "report.json", j.dump(2) + "\n");
+    write_file_atomic(dir / "report.json", json_report_text(j) + "\n");
     std::printf(
         "demo: 5 stacked cloth-like layers, %zu vertices; outputs in %s/ (input.json, naive.json, "
         "strata.json, compare.svg, report.json)\n",
@@ -137,7 +137,7 @@ int run_batch(const SimplifyOptions& opt, const std::vector<std::string>& files)
         all.push_back(batch_entry(o));
     }
     std::fputs(batch_footer(totals, peak_memory_mib()).c_str(), stdout);
-    if (!opt.report.empty()) write_file_atomic(opt.report, all.dump(2) + "\n");
+    if (!opt.report.empty()) write_file_atomic(opt.report, json_report_text(all) + "\n");
     return totals.exit_code();
 }
 
@@ -278,7 +278,7 @@ Run add_simplify_command(CLI::App& app) {
             nlohmann::json j = report_json(*out.report, naive_report);
             if (untangled) j["input_untangled"] = untangling_json(*untangled);
             j["peak_memory_mib"] = peak_memory_mib();
-            write_file_atomic(o.report, j.dump(2) + "\n");
+            write_file_atomic(o.report, json_report_text(j) + "\n");
         }
         print_summary(name, *out.report, naive_report);
         return out.report->collision_free ? 0 : 1;

@@ -172,7 +172,7 @@ Run add_untangle_command(CLI::App& app) {
                               {"rolled_vertices", r.rolled_vertices},
                               {"rolled_kept", r.rolled_kept},
                               {"reading", r.sides_reading}};
-            write_file_atomic(opt->report, j.dump(2) + "\n");
+            write_file_atomic(opt->report, json_report_text(j) + "\n");
         }
         std::printf("%s -> %s: %zu layers, %zu vertices\n", opt->input.c_str(), opt->output.c_str(),
                     scene.size(), scene.vertex_count());

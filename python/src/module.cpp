@@ -82,9 +82,11 @@ cli::InputCrossings parse_input_crossings(const std::string& name) {
     throw InvalidInput("input_crossings: '" + name + "' not in {untangle, skip, fail}");
 }
 
-// Python's json.loads of `j`.
+// Python's json.loads of `j` (stray bytes of a name that is not UTF-8 as U+FFFD, as the CLI's
+// JSON reports have them).
 py::object to_python(const nlohmann::json& j) {
-    return py::module_::import("json").attr("loads")(j.dump());
+    return py::module_::import("json").attr("loads")(
+        j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 // A count option: a whole number >= `min` (as the CLI's add_count_option()).

@@ -614,8 +614,15 @@ class Reader {
     std::string source_;
 };
 
+// `s` as a JSON string. JSON holds UTF-8 text only: a name read from an SVG id may hold other
+// bytes, refused here by name rather than passed on as nlohmann's type_error.
 std::string quoted(const std::string& s) {
-    return json(s).dump();
+    try {
+        return json(s).dump();
+    } catch (const json::type_error&) {
+        throw InvalidInput("scene_to_json: '" + shown_text(s) +
+                           "' is not UTF-8 text, which JSON cannot hold (rename it)");
+    }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <glm/geometric.hpp>
 #include <initializer_list>
+#include <limits>
 #include <optional>
 #include <unordered_map>
 #include <utility>
@@ -52,6 +53,81 @@ struct Origin {
 // `text` shortened and shown safely for a message.
 std::string excerpt(std::string_view text, std::size_t max_chars = 40) {
     return shown_text(text, max_chars);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Names that XML cannot hold. XML 1.0 has no place for a C0 control other than tab, newline and
+// return, nor for bytes of no UTF-8 character (not even as a reference such as &#27;). A
+// document holding such a name (an id, a name of data-outer, the units) is written with every
+// name as shown_text() shows it (\xNN, a backslash as \\) and this root attribute, by which the
+// reader turns them back.
+
+constexpr const char* kNamesAttribute = "data-strata-names";
+constexpr const char* kEscapedNames = "escaped";
+
+// Length of the character at the start of `text` when it is one XML 1.0 allows, else 0.
+std::size_t xml_char_length(std::string_view text) {
+    const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+    const unsigned char lead = byte(0);
+    if (lead < 0x80) return lead >= 0x20 || lead == '\t' || lead == '\n' || lead == '\r' ? 1 : 0;
+    std::size_t length = 0;
+    char32_t code = 0;
+    if (lead >= 0xc2 && lead <= 0xdf) {
+        length = 2;
+        code = lead & 0x1fu;
+    } else if (lead >= 0xe0 && lead <= 0xef) {
+        length = 3;
+        code = lead & 0x0fu;
+    } else if (lead >= 0xf0 && lead <= 0xf4) {
+        length = 4;
+        code = lead & 0x07u;
+    } else {
+        return 0;
+    }
+    if (text.size() < length) return 0;
+    for (std::size_t i = 1; i < length; ++i) {
+        if ((byte(i) & 0xc0u) != 0x80u) return 0;
+        code = (code << 6) | (byte(i) & 0x3fu);
+    }
+    const char32_t smallest = length == 2 ? 0x80 : length == 3 ? 0x800 : 0x10000;
+    if (code < smallest || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;
+    if (code == 0xfffe || code == 0xffff) return 0;
+    return length;
+}
+
+// True when XML can hold `text` (escaped as markup needs).
+bool is_xml_text(std::string_view text) {
+    for (std::size_t i = 0; i < text.size();) {
+        const std::size_t n = xml_char_length(text.substr(i));
+        if (n == 0) return false;
+        i += n;
+    }
+    return true;
+}
+
+// shown_text() undone: \\ a backslash, \xNN the byte NN; any other backslash kept as it is.
+std::string unshown_text(std::string_view text) {
+    const auto hex = [](char c) {
+        return c >= '0' && c <= '9'   ? c - '0'
+               : c >= 'a' && c <= 'f' ? c - 'a' + 10
+               : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                      : -1;
+    };
+    std::string out;
+    out.reserve(text.size());
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        if (text[i] == '\\' && i + 1 < text.size() && text[i + 1] == '\\') {
+            out += '\\';
+            ++i;
+        } else if (text[i] == '\\' && i + 3 < text.size() && text[i + 1] == 'x' &&
+                   hex(text[i + 2]) >= 0 && hex(text[i + 3]) >= 0) {
+            out += static_cast<char>(hex(text[i + 2]) * 16 + hex(text[i + 3]));
+            i += 3;
+        } else {
+            out += text[i];
+        }
+    }
+    return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -645,8 +721,14 @@ bool is_container(std::string_view name) {
 
 class SvgReader {
   public:
-    SvgReader(const std::string& source, const SvgReadParams& params)
-        : source_(source), params_(params) {}
+    // `escaped_names`: the document's names are written as shown_text() shows them.
+    SvgReader(const std::string& source, const SvgReadParams& params, bool escaped_names)
+        : source_(source), params_(params), escaped_names_(escaped_names) {}
+
+    // A name as the document writes it, as the scene holds it.
+    std::string name_of(std::string_view written) const {
+        return escaped_names_ ? unshown_text(written) : std::string(written);
+    }
 
     void walk(const tinyxml2::XMLElement* parent, const Affine& transform) {
         for (const tinyxml2::XMLElement* e = parent->FirstChildElement(); e;
@@ -829,7 +911,13 @@ class SvgReader {
             while (!rest.empty()) {
                 const std::size_t cut = rest.find_first_of(", \t\n\r\f");
                 const std::string_view token = rest.substr(0, cut);
-                if (!token.empty()) names.emplace_back(token);
+                if (!token.empty()) {
+                    names.push_back(name_of(token));
+                    // An escaped separator: a name that data-outer cannot list (nor write back).
+                    if (names.back().find_first_of(", \t\n\r\f") != std::string::npos)
+                        fail(origin, "data-outer names '" + excerpt(names.back()) +
+                                         "', which holds a space or comma");
+                }
                 rest = cut == std::string_view::npos ? std::string_view() : rest.substr(cut + 1);
             }
             base.outer = std::move(names);
@@ -839,8 +927,7 @@ class SvgReader {
         for (std::size_t k = 0; k < subpaths.size(); ++k) {
             Layer layer = base;
             if (id && *id)
-                layer.name =
-                    k == 0 ? std::string(id) : std::string(id) + "_" + std::to_string(k + 1);
+                layer.name = k == 0 ? name_of(id) : name_of(id) + "_" + std::to_string(k + 1);
             else
                 layer.name = "layer_" + std::to_string(layers_.size());
             layer.points = subpaths[k].points;
@@ -858,6 +945,7 @@ class SvgReader {
 
     const std::string& source_;
     const SvgReadParams& params_;
+    bool escaped_names_ = false;
     std::size_t curve_points_ = 0;  // vertices made by flattening so far
     std::vector<Layer> layers_;
     std::vector<Origin> origins_;
@@ -920,8 +1008,9 @@ std::string points_text(const Layer& layer) {
     return out;
 }
 
-std::string layer_summary(const Layer& layer) {
-    std::string out = layer.name + ": " + (layer.closed ? "closed" : "open") + ", " +
+// `name`: the layer's name as the document writes it.
+std::string layer_summary(const Layer& layer, const std::string& name) {
+    std::string out = name + ": " + (layer.closed ? "closed" : "open") + ", " +
                       std::to_string(layer.points.size()) + " points, thickness " +
                       format_number(layer.thickness) + ", weight " + format_number(layer.weight);
     if (layer.alpha) out += ", alpha " + format_number(*layer.alpha);
@@ -960,13 +1049,14 @@ Scene parse_scene_svg(std::string_view text, const std::string& source,
     if (local_name(root->Name()) != "svg")
         throw InvalidInput(source + ":" + std::to_string(root->GetLineNum()) +
                            ": root element is <" + root->Name() + ">, not <svg>");
-    SvgReader reader(source, params);
+    const char* names = root->Attribute(kNamesAttribute);
+    SvgReader reader(source, params, names && std::string_view(names) == kEscapedNames);
     Affine m;
     if (const char* t = root->Attribute("transform"))
         m = parse_transform(t, Origin{source, root->GetLineNum(), "<svg>"});
     reader.walk(root, m);
     const char* units = root->Attribute("data-strata-units");
-    return reader.finish(units ? units : "");
+    return reader.finish(units ? reader.name_of(units) : "");
 }
 
 Scene read_scene_svg(const std::filesystem::path& path, const SvgReadParams& params) {
@@ -982,9 +1072,19 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
         for (std::size_t i = 0; i < scene.size(); ++i)
             for (const std::size_t j : scene.outer_of(i))
                 if (scene.layer(j).name.find_first_of(", \t\n\r\f") != std::string::npos)
-                    throw InvalidInput("scene_to_svg: layer '" + scene.layer(j).name +
+                    throw InvalidInput("scene_to_svg: layer '" + excerpt(scene.layer(j).name) +
                                        "': a name with a space or comma cannot be written in "
                                        "data-outer");
+
+    // Names XML cannot hold: every name of the document as shown_text() shows it.
+    bool escaped = !is_xml_text(scene.units());
+    for (const Scene* s : {&scene, params.underlay})
+        if (s)
+            for (const Layer& layer : s->layers()) escaped = escaped || !is_xml_text(layer.name);
+    const auto written = [escaped](std::string_view name) {
+        return escaped ? shown_text(name, std::numeric_limits<std::size_t>::max())
+                       : std::string(name);
+    };
 
     Box2 box = scene.bounds();
     if (params.underlay) box.extend(params.underlay->bounds());
@@ -1007,7 +1107,8 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
     out += attribute("height", format_number(height_px));
     out += attribute("viewBox", format_number(view_x) + " " + format_number(view_y) + " " +
                                     format_number(view_w) + " " + format_number(view_h));
-    if (!scene.units().empty()) out += attribute("data-strata-units", scene.units());
+    if (escaped) out += attribute(kNamesAttribute, kEscapedNames);
+    if (!scene.units().empty()) out += attribute("data-strata-units", written(scene.units()));
     out += ">\n";
 
     auto element_name = [](const Layer& layer) { return layer.closed ? "polygon" : "polyline"; };
@@ -1028,8 +1129,9 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
         for (const Layer& layer : params.underlay->layers()) {
             out += "  <" + std::string(element_name(layer)) +
                    attribute("points", points_text(layer)) + attribute("stroke-width", stroke) +
-                   "><title>" + xml_escape("underlay " + layer_summary(layer)) + "</title></" +
-                   element_name(layer) + ">\n";
+                   "><title>" +
+                   xml_escape("underlay " + layer_summary(layer, written(layer.name))) +
+                   "</title></" + element_name(layer) + ">\n";
         }
         out += "</g>\n";
     }
@@ -1037,7 +1139,7 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
     for (std::size_t i = 0; i < scene.size(); ++i) {
         const Layer& layer = scene.layer(i);
         const char* colour = kPalette[i % kPalette.size()];
-        out += "<" + std::string(element_name(layer)) + attribute("id", layer.name) +
+        out += "<" + std::string(element_name(layer)) + attribute("id", written(layer.name)) +
                attribute("points", points_text(layer)) + attribute("fill", "none") +
                attribute("stroke", colour) + attribute("stroke-width", stroke) +
                attribute("stroke-linejoin", "round") +
@@ -1048,11 +1150,11 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
         if (explicit_outer) {
             std::string names;
             for (const std::size_t j : scene.outer_of(i))
-                names += (names.empty() ? "" : " ") + scene.layer(j).name;
+                names += (names.empty() ? "" : " ") + written(scene.layer(j).name);
             out += attribute("data-outer", names);
         }
-        out += "><title>" + xml_escape(layer_summary(layer)) + "</title></" + element_name(layer) +
-               ">\n";
+        out += "><title>" + xml_escape(layer_summary(layer, written(layer.name))) + "</title></" +
+               element_name(layer) + ">\n";
         if (params.draw_vertices) out += dots(layer, colour);
     }
     out += "</svg>\n";

@@ -92,6 +92,26 @@ TEST_CASE("JSON round trips are exact", "[io][json]") {
     }
 }
 
+TEST_CASE("names with controls round trip; a name that is not UTF-8 is refused by name",
+          "[io][json]") {
+    std::vector<Layer> layers(2);
+    layers[0].name = "\033[1mbold\\";
+    layers[0].points = {{0.0, 0.0}, {1.0, 0.0}};
+    layers[1].name = "c1\302\2332";
+    layers[1].points = {{0.0, 1.0}, {1.0, 1.0}};
+    const Scene scene(layers, "c\001m");
+    const std::string text = scene_to_json(scene);
+    CHECK(text.find('\033') == std::string::npos);
+    CHECK_THAT(text, Contains(R"("\u001b[1mbold\\")"));
+    test::require_same_scene(scene, parse_scene_json(text), true);
+    // A lone 0x9b (an SVG id can hold one): JSON holds UTF-8 only.
+    layers[1].name = "a\233z";
+    CHECK_THROWS_AS(scene_to_json(Scene(layers)), InvalidInput);
+    CHECK_THROWS_WITH(scene_to_json(Scene(layers)), Contains("'a\\x9bz' is not UTF-8"));
+    layers[1].name = "b";
+    CHECK_THROWS_WITH(scene_to_json(Scene(layers, "c\377")), Contains("'c\\xff' is not UTF-8"));
+}
+
 TEST_CASE("bad JSON names the file, line and column", "[io][json]") {
     CHECK_THROWS_WITH(
         parse_scene_json("{\n  \"layers\": [\n    {\"points\": [[0, 0], [1 1]]}\n  ]\n}",

@@ -430,6 +430,73 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
     }
 }
 
+TEST_CASE("names XML cannot hold are written as shown_text() shows them and read back",
+          "[io][svg]") {
+    // XML 1.0 holds no C0 control but tab, newline and return (not even as &#27;) and no byte of
+    // no UTF-8 character: a browser refuses such a document, and a terminal showing it obeys ESC.
+    const Scene plain = explicit_scene();
+    SECTION("other names are written as they are, the document unmarked") {
+        std::vector<Layer> layers = plain.layers();
+        layers[0].name = "back\\slash";
+        layers[1].name = "c1\302\2332";  // U+009B, a character XML 1.0 allows
+        const Scene scene(layers, "cm");
+        const std::string svg = scene_to_svg(scene);
+        CHECK(svg.find("data-strata-names") == std::string::npos);
+        CHECK_THAT(svg, Contains("id=\"back\\slash\""));
+        test::require_same_scene(scene, parse_scene_svg(svg, "plain.svg"), false);
+    }
+    SECTION("ESC, a C0 control, broken UTF-8: every name escaped, the document marked") {
+        std::vector<Layer> layers = plain.layers();
+        layers[0].name = "\033[1mleft";
+        layers[1].name = "r\233ight\\x41";  // a lone 0x9b; a backslash then "x41"
+        layers[2].name = "co\001at";
+        layers[0].outer = std::vector<std::string>{layers[2].name};
+        layers[1].outer = std::vector<std::string>{layers[2].name};
+        const Scene scene(layers, "c\033m");
+        const std::string svg = scene_to_svg(scene);
+        CHECK_THAT(svg, Contains("<svg") && Contains(" data-strata-names=\"escaped\""));
+        CHECK_THAT(svg, Contains("id=\"\\x1b[1mleft\""));
+        CHECK_THAT(svg, Contains("id=\"r\\x9bight\\\\x41\""));
+        CHECK_THAT(svg, Contains("data-outer=\"co\\x01at\""));
+        CHECK_THAT(svg, Contains("data-strata-units=\"c\\x1bm\""));
+        CHECK_THAT(svg, Contains("<title>\\x1b[1mleft: closed"));
+        for (const char byte : {'\033', '\233', '\001'}) CHECK(svg.find(byte) == std::string::npos);
+        test::require_same_scene(scene, parse_scene_svg(svg, "odd.svg"), false);
+    }
+    SECTION("an underlay's name alone marks the document") {
+        std::vector<Layer> layers = plain.layers();
+        layers[2].name = "\033coat";
+        for (Layer& l : layers) l.outer.reset();
+        const Scene under(layers);
+        SvgWriteParams params;
+        params.underlay = &under;
+        const std::string svg = scene_to_svg(plain, params);
+        CHECK_THAT(svg, Contains("<title>underlay \\x1bcoat: open"));
+        CHECK(svg.find('\033') == std::string::npos);
+        test::require_same_scene(plain, parse_scene_svg(svg, "under.svg"), false);
+    }
+    SECTION("read: escapes are undone only in a marked document") {
+        const std::string body =
+            "<polygon id=\"a\\x41\\\\b\\q\" points=\"0,0 1,0 0,1\" data-outer=\"c\\x62\"/>\n"
+            "<polygon id=\"c\\x62\" points=\"-1,-1 2,-1 -1,2\" data-outer=\"\"/>\n</svg>\n";
+        const std::string head = "<svg xmlns=\"http://www.w3.org/2000/svg\"";
+        const Scene marked =
+            parse_scene_svg(head + " data-strata-names=\"escaped\">\n" + body, "marked.svg");
+        CHECK(marked.layer(0).name == "aA\\b\\q");
+        CHECK(marked.layer(1).name == "cb");
+        CHECK(marked.outer_of(0) == std::vector<std::size_t>{1});
+        const Scene unmarked = parse_scene_svg(head + ">\n" + body, "unmarked.svg");
+        CHECK(unmarked.layer(0).name == "a\\x41\\\\b\\q");
+        CHECK(unmarked.layer(1).name == "c\\x62");
+        // An escaped space in data-outer: a name it cannot list.
+        CHECK_THROWS_WITH(
+            parse_scene_svg(head + " data-strata-names=\"escaped\">\n<polygon id=\"a\" "
+                                   "points=\"0,0 1,0 0,1\" data-outer=\"b\\x20c\"/></svg>\n",
+                            "space.svg"),
+            Contains("space.svg:2") && Contains("data-outer names 'b c'"));
+    }
+}
+
 TEST_CASE("viewBox covers the scene and the underlay with a margin", "[io][svg]") {
     Layer a;
     a.name = "a";

@@ -22,12 +22,14 @@ namespace strata {
 Scene parse_scene_json(std::string_view text, const std::string& source = "<json>");
 
 /// The scene as JSON text (one layer per line group, points with full double precision).
+/// @throws InvalidInput when a name, the units or a key is not UTF-8 (JSON holds no other text;
+///         an SVG id can), naming it.
 std::string scene_to_json(const Scene& scene);
 
 /// read_text_file + parse_scene_json.  @throws IoError, InvalidInput.
 Scene read_scene_json(const std::filesystem::path& path);
 
-/// scene_to_json + write_file_atomic.  @throws IoError.
+/// scene_to_json + write_file_atomic.  @throws IoError, InvalidInput (as scene_to_json).
 void write_scene_json(const Scene& scene, const std::filesystem::path& path);
 
 }  // namespace strata

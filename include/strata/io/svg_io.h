@@ -22,6 +22,11 @@
 /// - When any element has data-outer, every layer has `outer` set (empty when absent);
 ///   otherwise the document order is one implicit stack. data-strata-units on the root <svg>
 ///   gives the scene's units. Layer::extra and Scene::metadata are not carried by SVG.
+/// - Names XML 1.0 cannot hold (a C0 control other than tab, newline and return, e.g. ESC; a
+///   byte of no UTF-8 character): when the scene or the underlay has one, the writer writes
+///   every name and the units as shown_text() shows them (\xNN, a backslash as \\) and marks
+///   the root data-strata-names="escaped"; the reader undoes \\ and \xNN in the ids,
+///   data-outer and data-strata-units of a document so marked, and only there.
 
 #include "strata/geometry/scene.h"
 
