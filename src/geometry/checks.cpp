@@ -792,14 +792,15 @@ double one_sided_hausdorff(const Layer& a, const SegmentIndex& b, double toleran
 
 void check_hausdorff_input(const Layer& layer, const char* which) {
     if (layer.points.empty())
-        throw InvalidInput(std::string("hausdorff: layer ") + which + " ('" + layer.name +
-                           "') has no points");
+        throw InvalidInput(std::string("hausdorff: layer ") + which + " ('" +
+                           shown_text(layer.name) + "') has no points");
     for (std::size_t k = 0; k < layer.points.size(); ++k) {
         const Vec2& p = layer.points[k];
         if (!std::isfinite(p.x) || !std::isfinite(p.y))
-            throw InvalidInput(std::string("hausdorff: layer ") + which + " ('" + layer.name +
-                               "'): point " + std::to_string(k) + " has a non-finite coordinate (" +
-                               format_number(p.x) + ", " + format_number(p.y) + ")");
+            throw InvalidInput(std::string("hausdorff: layer ") + which + " ('" +
+                               shown_text(layer.name) + "'): point " + std::to_string(k) +
+                               " has a non-finite coordinate (" + format_number(p.x) + ", " +
+                               format_number(p.y) + ")");
     }
 }
 

@@ -1125,7 +1125,7 @@ void validate(const SliceParams& params) {
                            format_number(params.thickness) + ")");
     for (const auto& [name, t] : params.mesh_thickness)
         if (!(std::isfinite(t) && t >= 0.0))
-            throw InvalidInput("slice: params.mesh_thickness['" + name +
+            throw InvalidInput("slice: params.mesh_thickness['" + shown_text(name) +
                                "'] must be finite and >= 0 (got " + format_number(t) + ")");
     validate(params.nesting);
     validate(params.weld);
@@ -1144,8 +1144,8 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
         auto it = by_name.find(name);
         if (it == by_name.end()) {
             std::string known;
-            for (const auto& [k, v] : by_name) known += (known.empty() ? "" : ", ") + k;
-            throw InvalidInput("slice: params.order names '" + name +
+            for (const auto& [k, v] : by_name) known += (known.empty() ? "" : ", ") + shown_text(k);
+            throw InvalidInput("slice: params.order names '" + shown_text(name) +
                                "', which is not a mesh (meshes: " + known + ")");
         }
         if (mesh_rank[it->second] >= 0)
@@ -1157,7 +1157,7 @@ SliceReport slice_meshes(const std::vector<SliceMesh>& meshes, const SliceParams
         if (mesh_rank[m] < 0) sequence.push_back(m);
     for (const auto& [name, t] : params.mesh_thickness)
         if (by_name.count(name) == 0)
-            throw InvalidInput("slice: params.mesh_thickness names '" + name +
+            throw InvalidInput("slice: params.mesh_thickness names '" + shown_text(name) +
                                "', which is not a mesh");
     std::vector<double> mesh_edge(meshes.size(), 0.0);
     if (params.weld.enabled && params.weld.tolerance == 0.0)
