@@ -80,6 +80,9 @@ Run add_untangle_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--voxel", p.field.voxel_size, "Grid voxel size (scene units; 0 = auto)")
         ->capture_default_str();
+    cmd->add_flag("--give-up-when-stalled", p.give_up_when_stalled,
+                  "End a try early when its violation, extrapolated, would not fall enough by the "
+                  "pass cap");
     cmd->add_flag("--no-shape-matching", opt->no_shape_matching,
                   "Pure projection (the paper's Fig. 2 artefacts)");
     cmd->add_flag("--no-finish", opt->no_finish,
