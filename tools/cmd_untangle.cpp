@@ -169,7 +169,8 @@ Run add_untangle_command(CLI::App& app) {
                 {"finish_moves", r.finish_moves},
                 {"kept_simple", r.kept_simple},
                 {"long_rounds", r.long_rounds},
-                {"more_passes", r.more_passes}};
+                {"more_passes", r.more_passes},
+                {"gave_up", r.gave_up}};
             if (params.input_sides)
                 j["sides"] = {{"from", reference ? opt->reference : "inferred"},
                               {"rolled_vertices", r.rolled_vertices},
@@ -207,6 +208,7 @@ Run add_untangle_command(CLI::App& app) {
             "finish %.3f, check %.3f)\n",
             r.tries, r.passes, r.rounds,
             r.collision_free ? "collision-free"
+            : r.gave_up      ? "NOT collision-free, gave up stalled"
             : r.converged    ? "converged, NOT collision-free"
                              : "NOT collision-free at the pass cap",
             seconds, r.seconds_fields, r.seconds_untangle, r.seconds_finish, r.seconds_check);
