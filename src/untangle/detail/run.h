@@ -1,0 +1,21 @@
+#pragma once
+// One untangling of a set of pieces, the core of untangle(), untangle_inferring_sides() and
+// untangle_local(). Internal to the untangle module.
+
+#include "strata/core/progress.h"
+#include "strata/untangle/localize.h"
+#include "strata/untangle/untangle.h"
+
+#include <vector>
+
+namespace strata::detail {
+
+// `region`: the vertices that may move (the free vertices of `pieces`) stay in this box, with
+// their neighbours, or the check is of the whole scene; the checks then look only near it
+// (RegionCheck), with the same verdicts as whole ones. nullptr: whole checks.
+// `keep_simple`: EngineSettings::keep_simple (no vertex move that makes a self-crossing).
+UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
+                              const UntangleParams& params, const ProgressFn& progress,
+                              bool keep_simple = false, const Box2* region = nullptr);
+
+}  // namespace strata::detail

@@ -1,0 +1,271 @@
+// The tries of a whole-scene untangling (untangle(), untangle_inferring_sides()): a second try
+// from the input, the inferred sides and the global order, other readings, long rounds and
+// more passes, each one an untangling of the whole scene by detail::run_untangling().
+#include "strata/untangle/untangle.h"
+
+#include "strata/geometry/input_sides.h"
+#include "untangle/detail/run.h"
+
+#include <algorithm>
+#include <limits>
+#include <optional>
+#include <utility>
+#include <vector>
+
+namespace strata {
+
+namespace {
+
+// `given`, with the outside sides of untangling_outside_sides(scene) unless it gives them.
+UntangleParams with_outside_sides(const Scene& scene, const UntangleParams& given) {
+    UntangleParams params = given;
+    if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
+    return params;
+}
+
+// One untangling of the whole scene; `keep_simple`: EngineSettings::keep_simple.
+UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const ProgressFn& progress,
+                             bool keep_simple) {
+    UntangleReport report =
+        detail::run_untangling(scene, whole_scene_pieces(scene), params, progress, keep_simple);
+    report.kept_simple = keep_simple;
+    return report;
+}
+
+// What the tries of one call cost (UntangleReport::tries, passes, rounds, finishes,
+// finish_moves and seconds), summed over every try whichever try's result is kept.
+struct TriesCost {
+    UntangleReport sum;
+
+    void add(const UntangleReport& r) {
+        sum.tries += r.tries;
+        sum.passes += r.passes;
+        sum.rounds += r.rounds;
+        sum.finishes += r.finishes;
+        sum.finish_moves += r.finish_moves;
+        sum.seconds_fields += r.seconds_fields;
+        sum.seconds_untangle += r.seconds_untangle;
+        sum.seconds_check += r.seconds_check;
+        sum.seconds_finish += r.seconds_finish;
+    }
+
+    // `kept` (the result of one of the tries) with the cost of all of them.
+    UntangleReport charged_to(UntangleReport kept) const {
+        kept.tries = sum.tries;
+        kept.passes = sum.passes;
+        kept.rounds = sum.rounds;
+        kept.finishes = sum.finishes;
+        kept.finish_moves = sum.finish_moves;
+        kept.seconds_fields = sum.seconds_fields;
+        kept.seconds_untangle = sum.seconds_untangle;
+        kept.seconds_check = sum.seconds_check;
+        kept.seconds_finish = sum.seconds_finish;
+        return kept;
+    }
+};
+
+// a x b for positive counts, at most INT_MAX (a pass cap or a step count a user made large).
+int saturated_product(int a, int b) {
+    const long long product = static_cast<long long>(a) * static_cast<long long>(b);
+    return static_cast<int>(std::min<long long>(product, std::numeric_limits<int>::max()));
+}
+
+// After a failed try (`failed`, whose result `scene` holds), another one from the input
+// (`second`, its result in `attempt`): the second result is kept when clean, the first stands
+// otherwise; the report counts both.
+UntangleReport after_retry(Scene& scene, const UntangleReport& failed, Scene&& attempt,
+                           const UntangleReport& second) {
+    TriesCost cost;
+    cost.add(failed);
+    cost.add(second);
+    if (!second.collision_free) return cost.charged_to(failed);
+    scene = std::move(attempt);
+    return cost.charged_to(second);
+}
+
+}  // namespace
+
+namespace {
+
+// Whether `scene` has regions on a rolled side by its inferred sides (infer_input_sides()):
+// where it has, which side a region belongs on is in question.
+bool has_rolled_regions(const Scene& scene) {
+    const std::vector<int> outside = untangling_outside_sides(scene);
+    return infer_input_sides(scene, {}, outside).rolled_count(scene, outside) > 0;
+}
+
+// When the tries with params fail, they run again with long rounds (UntangleParams::
+// long_rounds_factor) and the first clean result is kept; the report counts both. Where the
+// sides are in question (`in_question()`: not an original's, and the scene has rolled regions;
+// asked only when the tries failed), the retry takes the inferred sides alone
+// (`tries(scene, params, true)`), which keep the rolled regions: with the global order and the
+// other readings, longer rounds let a wrong reading hold (the collar at 95%, seeds 4 and 9,
+// came out clean by the global order with its fold unrolled), and the untangling had better
+// say it failed.
+template <class Tries, class InQuestion>
+UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params,
+                                InQuestion&& in_question_of, Tries&& tries) {
+    const Scene input = scene;
+    UntangleReport report = tries(scene, params, false);
+    if (report.collision_free || params.long_rounds_factor <= 1) return report;
+    const bool in_question = in_question_of(input);
+    UntangleParams longer = params;
+    longer.gradient_steps = saturated_product(params.gradient_steps, params.long_rounds_factor);
+    longer.long_rounds_factor = 1;
+    Scene attempt = input;
+    UntangleReport second = tries(attempt, longer, in_question);
+    second.long_rounds = true;
+    return after_retry(scene, report, std::move(attempt), second);
+}
+
+UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
+                              const ProgressFn& progress) {
+    const UntangleParams params = with_outside_sides(scene, given);
+    const Scene input = scene;
+    UntangleReport report = untangle_once(scene, params, progress, false);
+    if (report.collision_free) return report;
+    // Second try, from the input: no vertex move that makes a self-crossing (the projection
+    // and shape matching make them, and nothing takes them out: docs/untangle.md).
+    Scene simple = input;
+    const UntangleReport second = untangle_once(simple, params, progress, true);
+    return after_retry(scene, report, std::move(simple), second);
+}
+
+// `inferred_only`: the tries by the inferred sides alone, when they have rolled regions (a
+// failed report otherwise); no global order, no other reading.
+UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
+                                     const ProgressFn& progress, InputSides* kept,
+                                     bool inferred_only) {
+    // Regions of the input on the other side of an open layer than the global order says (a
+    // roll, which the global order pushes back): kept there, when that comes out clean.
+    const InputSides recorded = record_input_sides(scene);
+    const UntangleParams global = with_outside_sides(scene, params);
+    InputSides inferred = recorded.by_region(scene, global.outside_sides);
+    UntangleParams with_sides = global;
+    with_sides.input_sides = &inferred;
+    with_sides.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
+    const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
+    // By the inferred sides, then by the global order; the second tries (no self-crossing
+    // made) only when neither first try is clean, so that a scene one of them cleans costs
+    // what it did without them.
+    const Scene input = scene;
+    UntangleReport first;  // the global order's first try: the result when nothing is clean
+    Scene first_scene;
+    TriesCost cost;
+    // One try from the input into `attempt`; true when it comes out clean.
+    auto clean_try = [&](const UntangleParams& p, bool keep_simple, Scene& attempt,
+                         UntangleReport& report) {
+        attempt = input;
+        report = untangle_once(attempt, p, progress, keep_simple);
+        cost.add(report);
+        return report.collision_free;
+    };
+    if (inferred_only) {
+        UntangleReport report;
+        if (!rolled) return report;
+        for (bool keep_simple : {false, true}) {
+            Scene attempt;
+            if (!clean_try(with_sides, keep_simple, attempt, report)) continue;
+            report.inferred_sides = true;
+            if (kept) *kept = std::move(inferred);
+            scene = std::move(attempt);
+            return cost.charged_to(report);
+        }
+        return cost.charged_to(report);
+    }
+    for (bool keep_simple : {false, true}) {
+        Scene attempt;
+        UntangleReport report;
+        if (rolled && clean_try(with_sides, keep_simple, attempt, report)) {
+            report.inferred_sides = true;
+            if (kept) *kept = std::move(inferred);
+        } else if (!clean_try(global, keep_simple, attempt, report)) {
+            if (!keep_simple) {
+                first = report;
+                first_scene = std::move(attempt);
+            }
+            // Without rolled regions the inferred sides are the global order's, but for the
+            // vertices they give no side (around an end of the other layer, a tie): there only
+            // the distance counts. A fold cut by the decimation (the folded scenes) can come
+            // out clean so where the global order, pushing those vertices too, does not.
+            if (rolled || !clean_try(with_sides, keep_simple, attempt, report)) continue;
+            report.inferred_sides = true;
+            if (kept) *kept = std::move(inferred);
+        }
+        scene = std::move(attempt);
+        return cost.charged_to(report);
+    }
+    // Neither is clean: the other readings of the regions whose recorded sides disagree
+    // (InputSides::region_alternatives(), at most params.other_readings of them, best fitting
+    // first), each tried once, then once more without self-crossings made (as above); of the
+    // clean results of the first round that has one, the one that moves the input least.
+    std::vector<InputSides> others;
+    if (params.other_readings > 0)
+        others = recorded.region_alternatives(scene, global.outside_sides);
+    if (others.size() > params.other_readings) others.resize(params.other_readings);
+    for (bool keep_simple : {false, true}) {
+        std::size_t best = others.size();
+        Scene best_scene;
+        UntangleReport best_report;
+        for (std::size_t i = 0; i < others.size(); ++i) {
+            UntangleParams p = global;
+            p.input_sides = &others[i];
+            p.open_cut_bends = false;
+            Scene attempt;
+            UntangleReport report;
+            if (!clean_try(p, keep_simple, attempt, report) ||
+                (best < others.size() && report.max_displacement >= best_report.max_displacement))
+                continue;
+            best = i;
+            best_scene = std::move(attempt);
+            best_report = report;
+        }
+        if (best == others.size()) continue;
+        best_report.inferred_sides = true;
+        best_report.sides_reading = best + 1;
+        if (kept) *kept = std::move(others[best]);
+        scene = std::move(best_scene);
+        return cost.charged_to(best_report);
+    }
+    scene = std::move(first_scene);
+    return cost.charged_to(first);
+}
+
+}  // namespace
+UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
+    return untangle_tries(scene, params, progress);
+}
+
+UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
+                                        const ProgressFn& progress, InputSides* kept) {
+    if (params.input_sides && !params.input_sides->empty())
+        return with_long_rounds(
+            scene, params, [](const Scene&) { return false; },  // the original's: not in question
+            [&](Scene& s, const UntangleParams& p, bool /*in_question*/) {
+                return untangle_tries(s, p, progress);
+            });
+    const Scene input = scene;
+    // has_rolled_regions(input), once, when a retry first asks.
+    std::optional<bool> rolled;
+    auto rolled_regions = [&](const Scene& s) {
+        if (!rolled) rolled = has_rolled_regions(s);
+        return *rolled;
+    };
+    UntangleReport report = with_long_rounds(
+        scene, params, rolled_regions, [&](Scene& s, const UntangleParams& p, bool in_question) {
+            return inferring_sides_tries(s, p, progress, kept, in_question);
+        });
+    // Every try failed: where the global order is the reading (nothing read rolled), its second
+    // try (no self-crossing made) once more with more passes: the projection of a fold cut by
+    // chords can wander for a few hundred passes before it comes out clean.
+    if (report.collision_free || params.more_passes_factor <= 1 || rolled_regions(input))
+        return report;
+    UntangleParams more = with_outside_sides(input, params);
+    more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
+    Scene attempt = input;
+    UntangleReport last = untangle_once(attempt, more, progress, true);
+    last.more_passes = true;
+    return after_retry(scene, report, std::move(attempt), last);
+}
+
+}  // namespace strata
