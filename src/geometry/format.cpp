@@ -1,5 +1,7 @@
 #include "strata/core/format.h"
 
+#include "geometry/detail/utf8.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -34,33 +36,10 @@ std::string format_number(double value) {
 namespace {
 
 // The length of the well-formed UTF-8 sequence of a printable character at the start of `text`
-// (no overlong form, no surrogate, at most U+10FFFF, not a C1 control); 0 when there is none.
+// (detail::utf8_char(), not a C1 control); 0 when there is none.
 std::size_t printable_utf8_length(std::string_view text) {
-    const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
-    const unsigned char lead = byte(0);
-    std::size_t length = 0;
-    char32_t code = 0;
-    if (lead >= 0xc2 && lead <= 0xdf) {
-        length = 2;
-        code = lead & 0x1fu;
-    } else if (lead >= 0xe0 && lead <= 0xef) {
-        length = 3;
-        code = lead & 0x0fu;
-    } else if (lead >= 0xf0 && lead <= 0xf4) {
-        length = 4;
-        code = lead & 0x07u;
-    } else {
-        return 0;
-    }
-    if (text.size() < length) return 0;
-    for (std::size_t i = 1; i < length; ++i) {
-        if ((byte(i) & 0xc0u) != 0x80u) return 0;
-        code = (code << 6) | (byte(i) & 0x3fu);
-    }
-    const char32_t smallest = length == 2 ? 0x80 : length == 3 ? 0x800 : 0x10000;
-    if (code < smallest || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;
-    if (code < 0xa0) return 0;  // C1 controls
-    return length;
+    const detail::Utf8Char c = detail::utf8_char(text);
+    return c.code < 0xa0 ? 0 : c.length;  // C1 controls
 }
 
 }  // namespace

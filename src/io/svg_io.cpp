@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "geometry/detail/utf8.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/io/atomic_file.h"
@@ -67,32 +68,10 @@ constexpr const char* kEscapedNames = "escaped";
 
 // Length of the character at the start of `text` when it is one XML 1.0 allows, else 0.
 std::size_t xml_char_length(std::string_view text) {
-    const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
-    const unsigned char lead = byte(0);
+    const auto lead = static_cast<unsigned char>(text[0]);
     if (lead < 0x80) return lead >= 0x20 || lead == '\t' || lead == '\n' || lead == '\r' ? 1 : 0;
-    std::size_t length = 0;
-    char32_t code = 0;
-    if (lead >= 0xc2 && lead <= 0xdf) {
-        length = 2;
-        code = lead & 0x1fu;
-    } else if (lead >= 0xe0 && lead <= 0xef) {
-        length = 3;
-        code = lead & 0x0fu;
-    } else if (lead >= 0xf0 && lead <= 0xf4) {
-        length = 4;
-        code = lead & 0x07u;
-    } else {
-        return 0;
-    }
-    if (text.size() < length) return 0;
-    for (std::size_t i = 1; i < length; ++i) {
-        if ((byte(i) & 0xc0u) != 0x80u) return 0;
-        code = (code << 6) | (byte(i) & 0x3fu);
-    }
-    const char32_t smallest = length == 2 ? 0x80 : length == 3 ? 0x800 : 0x10000;
-    if (code < smallest || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;
-    if (code == 0xfffe || code == 0xffff) return 0;
-    return length;
+    const detail::Utf8Char c = detail::utf8_char(text);
+    return c.code == 0xfffe || c.code == 0xffff ? 0 : c.length;
 }
 
 // True when XML can hold `text` (escaped as markup needs).
