@@ -444,6 +444,7 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("crossings_after", &UntangleReport::crossings_after)
         .def_readonly("min_separation_ratio_after", &UntangleReport::min_separation_ratio_after)
         .def_readonly("inferred_sides", &UntangleReport::inferred_sides)
+        .def_readonly("gave_up", &UntangleReport::gave_up)
         .def_property_readonly("seconds", [](const UntangleReport& r) {
             return r.seconds_fields + r.seconds_untangle + r.seconds_finish + r.seconds_check;
         });
@@ -466,6 +467,8 @@ PYBIND11_MODULE(_strata, m) {
                 if (!v.cast<bool>()) u.shape = ShapeMode::None;
             } else if (key == "finish")
                 u.finish_separations = v.cast<bool>();
+            else if (key == "give_up_when_stalled")
+                u.give_up_when_stalled = v.cast<bool>();
             else
                 throw py::type_error("untangle: unexpected keyword argument '" + key + "'");
         }

@@ -245,6 +245,7 @@ def untangle(
     shape_matching: bool = True,
     finish: bool = True,
     global_order: bool = False,
+    give_up_when_stalled: bool = False,
     progress: Optional[Callable[[str, float], bool]] = None,
 ) -> Tuple[Scene, UntangleReport]:
     """Untangles a scene that already crosses (the global mode of ``strata untangle``, without
@@ -259,7 +260,10 @@ def untangle(
     ``max_rounds`` 1 per pass; ``max_passes`` 64; ``shape_matching`` (default True; False =
     pure projection); ``finish`` (default True; False = no finishing stage, the paper's
     untangling alone); ``global_order`` (default False; True = the global order alone, as
-    ``strata untangle --global-order``). ``progress``: as in
+    ``strata untangle --global-order``); ``give_up_when_stalled`` (default False; True = end each
+    try early when its violation, extrapolated, would not fall enough by the pass cap, as
+    ``strata untangle --give-up-when-stalled``: faster failures, fewer successes;
+    ``report.gave_up``). ``progress``: as in
     :func:`simplify`, called once per round ("untangle", fraction)."""
     return _strata._untangle(
         scene,
@@ -274,6 +278,7 @@ def untangle(
             shape_matching=shape_matching,
             finish=finish,
             global_order=global_order,
+            give_up_when_stalled=give_up_when_stalled,
         ),
         progress,
     )

@@ -152,6 +152,7 @@ class UntangleReport:
     crossings_after: int
     min_separation_ratio_after: float
     inferred_sides: bool  #: The input's rolled regions kept (sides inferred per region).
+    gave_up: bool  #: The result's try ended early, stalled (give_up_when_stalled).
     @property
     def seconds(self) -> float: ...
 

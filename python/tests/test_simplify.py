@@ -129,6 +129,16 @@ def test_untangle_mends_a_crossing_pair():
     assert strata.check(scene).crossings == before.crossings  # the input is not changed
 
 
+def test_untangle_gives_up_when_stalled_only_when_asked():
+    # A folded stack at 95% that no try cleans (13 s of 25 tries by default): asked to, every
+    # try gives up early, and the report says so.
+    scene = strata.read_scene(DATA / "folded_stack_tangled_95.json")
+    result, report = strata.untangle(scene, give_up_when_stalled=True)
+    assert not report.collision_free and report.gave_up
+    assert report.passes < report.tries * 64  # the tries ended before their pass cap
+    assert not strata.check(result).collision_free
+
+
 def test_untangle_keeps_a_roll_unless_told_the_global_order():
     # A shirt rolled over the end of a jacket, tangled by naive random decimation (as the CLI
     # tests do): by default its rolled regions keep their inferred sides; the global order
