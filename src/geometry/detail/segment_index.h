@@ -6,6 +6,7 @@
 
 #include "geometry/detail/uniform_grid.h"
 #include "strata/core/types.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/geometry/predicates.h"
 #include "strata/geometry/scene.h"
 
