@@ -247,3 +247,59 @@ TEST_CASE("the finishing stage takes an open layer's end back behind a vertex ar
     CHECK(past_end() <= -0.9 * t);  // the end is behind the vertex by about the aim
     test::require_collision_free(scene, 0.1);
 }
+
+TEST_CASE("the finishing stage's cache across calls changes no result", "[separation]") {
+    // Random stacks of uneven segments, pieces around a box (most segments fixed), the free
+    // vertices moved between calls (their segments' lengths, and with them the median the
+    // stage reads, change): calls that keep a FinishCache give what calls without one give.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int moved = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        std::vector<Layer> layers;
+        for (int l = 0; l < 4; ++l) {
+            std::vector<Vec2> points;
+            double x = 0.0;
+            while (x < 4.0) {
+                points.emplace_back(x, 0.02 * l + 0.004 * (u(rng) - 0.5));
+                x += 0.04 + 0.2 * u(rng) * u(rng);
+            }
+            // Segments longer than the gaps aimed for: the median sets the stage's grid.
+            layers.push_back(polyline("l" + std::to_string(l), points, 0.03));
+        }
+        const Scene input(layers);
+        Box2 box;
+        box.extend(Vec2(1.0 + u(rng), -0.1));
+        box.extend(Vec2(1.5 + u(rng), 0.3));
+        const std::vector<Piece> pieces = localize(input, box, 3);
+        detail::RelationSource relations;
+        relations.scene = &input;
+        const std::vector<int> sides = outside_sides(input);
+        detail::SeparationParams params;
+        params.outside_signs = &sides;
+        Scene with = input, without = input;
+        detail::FinishCache cache;
+        for (int call = 0; call < 4; ++call) {
+            INFO("trial " << trial << ", call " << call);
+            const detail::SeparationResult a =
+                detail::finish_separations(with, pieces, relations, params, &cache);
+            const detail::SeparationResult b =
+                detail::finish_separations(without, pieces, relations, params);
+            REQUIRE(a.moves == b.moves);
+            REQUIRE(a.sweeps == b.sweeps);
+            REQUIRE(a.worst == b.worst);
+            for (std::size_t l = 0; l < input.size(); ++l)
+                REQUIRE(with.layer(l).points == without.layer(l).points);
+            moved += a.moves > 0 ? 1 : 0;
+            // The free vertices move along the layer (as the projection would move them).
+            for (const Piece& piece : pieces) {
+                std::vector<Vec2> points = with.layer(piece.layer).points;
+                for (std::size_t k = 0; k < piece.vertices.size(); ++k)
+                    if (piece.is_free[k]) points[piece.vertices[k]].x += 0.04 * (u(rng) - 0.5);
+                with.set_points(piece.layer, points);
+                without.set_points(piece.layer, points);
+            }
+        }
+    }
+    CHECK(moved > 10);
+}

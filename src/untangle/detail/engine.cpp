@@ -764,11 +764,13 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     // The last run of the finishing stage left a close vertex on the wrong side of another
     // layer (true when the stage is off: nothing tells).
     bool wrong_side = true;
+    FinishCache finish_cache;  // the same work scene and pieces at every call
     auto finish_and_check = [&](bool only_when_untangled) {
         if (params.finish_separations) {
             const auto begin = Clock::now();
             finish.only_when_untangled = only_when_untangled;
-            const SeparationResult f = finish_separations(work, pieces, relations, finish);
+            const SeparationResult f =
+                finish_separations(work, pieces, relations, finish, &finish_cache);
             wrong_side = f.wrong_side > 0;
             ++result.finishes;
             result.finish_moves += f.moves;

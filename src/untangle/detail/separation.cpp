@@ -83,9 +83,14 @@ class SegmentCells {
         built_ = pts_;
         drift_ = 0.0;
         origin_ = region_;
-        std::size_t segments = 0;
+        // The segments filed, in (layer, index) order: tested once, then read twice below.
+        filed_.clear();
         for (std::size_t l = 0; l < pts_.size(); ++l)
-            for (std::size_t k = 0; k < segment_count(l); ++k) segments += is_filed(l, k);
+            for (std::size_t k = 0; k < segment_count(l); ++k)
+                if (is_filed(l, k))
+                    filed_.push_back(
+                        {static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)});
+        const std::size_t segments = filed_.size();
         // At most about 4 cells per segment: a larger cell where the bounds are wide.
         const Vec2 size = origin_.size();
         double cell = cell_;
@@ -95,25 +100,20 @@ class SegmentCells {
         nx_ = static_cast<std::size_t>(size.x / cell) + 1;
         ny_ = static_cast<std::size_t>(size.y / cell) + 1;
         start_.assign(nx_ * ny_ + 1, 0);
-        auto each_cell = [&](std::size_t l, std::size_t k, auto&& g) {
-            const SegId s{static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)};
+        auto each_cell = [&](const SegId& s, auto&& g) {
             const Vec2 a = start(s), b = end(s);
             for (std::size_t iy = row(std::min(a.y, b.y)); iy <= row(std::max(a.y, b.y)); ++iy)
                 for (std::size_t ix = column(std::min(a.x, b.x)); ix <= column(std::max(a.x, b.x));
                      ++ix)
                     g(iy * nx_ + ix, s);
         };
-        for (std::size_t l = 0; l < pts_.size(); ++l)
-            for (std::size_t k = 0; k < segment_count(l); ++k)
-                if (is_filed(l, k))
-                    each_cell(l, k, [&](std::size_t c, const SegId&) { ++start_[c + 1]; });
+        for (const SegId& s : filed_)
+            each_cell(s, [&](std::size_t c, const SegId&) { ++start_[c + 1]; });
         for (std::size_t c = 0; c < nx_ * ny_; ++c) start_[c + 1] += start_[c];
         ids_.resize(start_.back());
         fill_ = start_;
-        for (std::size_t l = 0; l < pts_.size(); ++l)
-            for (std::size_t k = 0; k < segment_count(l); ++k)
-                if (is_filed(l, k))
-                    each_cell(l, k, [&](std::size_t c, const SegId& s) { ids_[fill_[c]++] = s; });
+        for (const SegId& s : filed_)
+            each_cell(s, [&](std::size_t c, const SegId& t) { ids_[fill_[c]++] = t; });
     }
     bool is_filed(std::size_t l, std::size_t k) const {
         const SegId s{static_cast<std::uint32_t>(l), static_cast<std::uint32_t>(k)};
@@ -138,6 +138,7 @@ class SegmentCells {
     std::size_t nx_ = 1, ny_ = 1;
     std::vector<std::uint32_t> start_, fill_;  // per cell, into ids_
     std::vector<SegId> ids_;
+    std::vector<SegId> filed_;         // build()'s segments, in (layer, index) order
     std::vector<std::size_t> offset_;  // first global id of each layer's segments
     std::vector<std::uint32_t> stamp_;
     std::uint32_t tick_ = 0;
@@ -158,8 +159,8 @@ bool in_closed_triangle(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2&
 class Finisher {
   public:
     Finisher(Scene& work, const std::vector<Piece>& pieces, const RelationSource& relations,
-             const SeparationParams& params)
-        : work_(work), relations_(relations), params_(params) {
+             const SeparationParams& params, FinishCache* cache)
+        : work_(work), pieces_(pieces), relations_(relations), params_(params), cache_(cache) {
         const std::size_t n = work.size();
         for (std::size_t l = 0; l < n; ++l) {
             pts_.push_back(work.layer(l).points);
@@ -187,14 +188,8 @@ class Finisher {
     SeparationResult run() {
         SeparationResult result;
         if (!(reach_ > 0.0)) return result;
-        std::vector<double> lengths;
-        for (std::size_t l = 0; l < pts_.size(); ++l)
-            for (std::size_t k = 0; k + 1 < pts_[l].size(); ++k)
-                lengths.push_back(glm::distance(pts_[l][k], pts_[l][k + 1]));
         double cell = 2.0 * reach_;
-        if (!lengths.empty()) {
-            auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-            std::nth_element(lengths.begin(), mid, lengths.end());
+        if (const std::optional<double> mid = median_length()) {
             cell = std::max(cell, *mid);
             tangle_reach_ = params_.tangle_reach * *mid;
         }
@@ -265,6 +260,75 @@ class Finisher {
 
   private:
     std::size_t layer_size(std::size_t l) const { return pts_[l].size(); }
+
+    // The median length of the segments (k, k + 1) of every layer (the closing segment of a
+    // closed layer left out), the element at position count / 2 in increasing order; none
+    // when there is no segment. With cache_, the fixed segments' lengths are taken from it.
+    std::optional<double> median_length() {
+        if (cache_ && !cache_->is_set) fill_cache();
+        if (cache_ && !cache_->fixed_lengths.empty()) {
+            moving_lengths_.clear();
+            for (const auto& [l, k] : cache_->moving)
+                moving_lengths_.push_back(glm::distance(pts_[l][k], pts_[l][k + 1]));
+            std::sort(moving_lengths_.begin(), moving_lengths_.end());
+            const std::vector<double>& a = cache_->fixed_lengths;
+            const std::vector<double>& b = moving_lengths_;
+            // The element at position k of the two sorted lists merged: i of the first k + 1
+            // come from `a`, the smallest i with a[i] >= b[k - i] (or i = min(k + 1, |a|)).
+            const std::size_t k = (a.size() + b.size()) / 2;
+            std::size_t lo = k + 1 > b.size() ? k + 1 - b.size() : 0;
+            std::size_t hi = std::min(k + 1, a.size());
+            while (lo < hi) {
+                const std::size_t i = lo + (hi - lo) / 2;
+                if (a[i] < b[k - i])
+                    lo = i + 1;
+                else
+                    hi = i;
+            }
+            const std::size_t j = k + 1 - lo;
+            if (lo == 0) return b[j - 1];
+            if (j == 0) return a[lo - 1];
+            return std::max(a[lo - 1], b[j - 1]);
+        }
+        std::vector<double> lengths;
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t k = 0; k + 1 < pts_[l].size(); ++k)
+                lengths.push_back(glm::distance(pts_[l][k], pts_[l][k + 1]));
+        if (lengths.empty()) return std::nullopt;
+        auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+        std::nth_element(lengths.begin(), mid, lengths.end());
+        return *mid;
+    }
+
+    // Fills cache_: the segments with a free end of a piece (only those move), and, when the
+    // others are most of the scene, their lengths sorted.
+    void fill_cache() {
+        FinishCache& c = *cache_;
+        c.is_set = true;
+        std::vector<std::vector<char>> free(pts_.size());
+        for (std::size_t l = 0; l < pts_.size(); ++l) free[l].assign(pts_[l].size(), 0);
+        for (const Piece& piece : pieces_)
+            for (std::size_t k = 0; k < piece.vertices.size(); ++k)
+                if (piece.is_free[k]) free[piece.layer][piece.vertices[k]] = 1;
+        std::size_t total = 0;
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t k = 0; k + 1 < pts_[l].size(); ++k) {
+                ++total;
+                if (free[l][k] || free[l][k + 1])
+                    c.moving.emplace_back(static_cast<std::uint32_t>(l),
+                                          static_cast<std::uint32_t>(k));
+            }
+        // Mostly moving (a whole-scene untangling): every call measures every segment.
+        if (2 * c.moving.size() >= total) {
+            c.moving.clear();
+            return;
+        }
+        for (std::size_t l = 0; l < pts_.size(); ++l)
+            for (std::size_t k = 0; k + 1 < pts_[l].size(); ++k)
+                if (!free[l][k] && !free[l][k + 1])
+                    c.fixed_lengths.push_back(glm::distance(pts_[l][k], pts_[l][k + 1]));
+        std::sort(c.fixed_lengths.begin(), c.fixed_lengths.end());
+    }
 
     // worst_ and wrong_side_ of the current positions, in the result too.
     void measure(SeparationResult& result, std::vector<bool>& changed) {
@@ -677,8 +741,11 @@ class Finisher {
     }
 
     Scene& work_;
+    const std::vector<Piece>& pieces_;
     const RelationSource& relations_;
     const SeparationParams& params_;
+    FinishCache* cache_ = nullptr;
+    std::vector<double> moving_lengths_;  // median_length()'s scratch
     std::vector<std::vector<Vec2>> pts_;
     std::vector<char> closed_;
     std::vector<std::vector<double>> inverse_mass_;
@@ -710,9 +777,9 @@ class Finisher {
 }  // namespace
 
 SeparationResult finish_separations(Scene& work, const std::vector<Piece>& pieces,
-                                    const RelationSource& relations,
-                                    const SeparationParams& params) {
-    return Finisher(work, pieces, relations, params).run();
+                                    const RelationSource& relations, const SeparationParams& params,
+                                    FinishCache* cache) {
+    return Finisher(work, pieces, relations, params, cache).run();
 }
 
 }  // namespace strata::detail

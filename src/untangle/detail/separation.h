@@ -19,6 +19,8 @@
 #include "untangle/detail/engine.h"
 
 #include <cstddef>
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace strata::detail {
@@ -70,10 +72,26 @@ struct SeparationResult {
     bool reverted = false;
 };
 
+/// What finish_separations() keeps from one call to the next on the same work scene and
+/// pieces (the engine's calls), where only the free vertices of the pieces move in between:
+/// the lengths of the segments between two fixed vertices, which the median segment length
+/// of every call reads. A local untangling's pieces hold a few percent of the scene; the
+/// lengths of the rest are then measured and sorted once, not at every call.
+struct FinishCache {
+    bool is_set = false;
+    /// When the fixed segments are most of the scene: their lengths, sorted; the segments with
+    /// a free end are (layer, first vertex) in `moving`. Else both empty (every call measures
+    /// every segment).
+    std::vector<double> fixed_lengths;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> moving;
+};
+
 /// Pushes the layers of `work` apart where they are closer than aimed for. Only the free
 /// vertices of `pieces` move. Deterministic (sequential, in layer and vertex order).
+/// `cache`: see FinishCache (nullptr: none); pass the same one only with the same `work`
+/// and `pieces`, with nothing but the free vertices moved since the last call.
 SeparationResult finish_separations(Scene& work, const std::vector<Piece>& pieces,
-                                    const RelationSource& relations,
-                                    const SeparationParams& params);
+                                    const RelationSource& relations, const SeparationParams& params,
+                                    FinishCache* cache = nullptr);
 
 }  // namespace strata::detail
