@@ -633,6 +633,10 @@ class Finisher {
                   std::vector<bool>& changed) {
         const Vec2 p = pts_[l][v];
         bool gathered = false;
+        // The candidate that refused the last attempt: a shorter move along the same line
+        // mostly meets it too, so it is tested first (is_safe() tests every candidate anyway:
+        // the order changes no verdict).
+        std::size_t blocker = kNoTip;
         for (int attempt = 0; attempt < 4; ++attempt, delta *= 0.5) {
             const Vec2 to = p + delta;
             if (to == p) return;
@@ -640,7 +644,7 @@ class Finisher {
             // between p and p + delta): its candidates serve them all.
             if (!gathered) gather_candidates(l, v, p, to);
             gathered = true;
-            if (!is_safe(l, v, p, to)) continue;
+            if (!is_safe(l, v, p, to, blocker)) continue;
             pts_[l][v] = to;
             cells_->moved(l, v);
             changed[l] = true;
@@ -687,7 +691,10 @@ class Finisher {
     // not meet can have passed through the moving ones, and no new contact is made.
     // The segments tested are those of candidates_ (gather_candidates() of this move or of a
     // longer one): every segment that may meet the move's box is among them.
-    bool is_safe(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to) const {
+    // `blocker`: a candidates_ index tested first (none: past the end); set to the one that
+    // refuses the move, if any.
+    bool is_safe(std::size_t l, std::size_t v, const Vec2& p, const Vec2& to,
+                 std::size_t& blocker) const {
         const std::size_t n = layer_size(l);
         const bool has_prev = closed_[l] || v > 0, has_next = closed_[l] || v + 1 < n;
         const std::size_t prev = (v + n - 1) % n, next = (v + 1) % n;
@@ -710,12 +717,13 @@ class Finisher {
         sweep_next = sweep_prev;
         if (has_prev) sweep_prev.extend(pts_[l][prev]);
         if (has_next) sweep_next.extend(pts_[l][next]);
-        for (const SegId& s : candidates_) {
+        // Whether candidate s refuses the move.
+        auto refuses = [&](const SegId& s) {
             const Vec2 a = cells_->start(s), b = cells_->end(s);
             // Everything tested below lies in `box`: the new and old segments and the swept
             // triangles. A segment whose box is apart from it can neither meet them nor have
             // an end inside a triangle.
-            if (is_apart(a, b, box)) continue;
+            if (is_apart(a, b, box)) return false;
             const bool with_prev = has_prev && !shares_end(s, prev, v);
             const bool with_next = has_next && !shares_end(s, v, next);
             const int now = (with_prev && meets(pts_[l][prev], to, a, b) ? 1 : 0) +
@@ -723,7 +731,7 @@ class Finisher {
             // Allowed only as often as the old segments met it.
             if (now > 0 && now > (with_prev && meets(pts_[l][prev], p, a, b) ? 1 : 0) +
                                      (with_next && meets(p, pts_[l][next], a, b) ? 1 : 0))
-                return false;
+                return true;
             const std::size_t ends[2] = {s.index, (s.index + 1) % layer_size(s.layer)};
             for (std::size_t e = 0; e < 2; ++e) {
                 if (is_mover(s.layer, ends[e])) continue;
@@ -731,11 +739,18 @@ class Finisher {
                 if (!box.contains(w)) continue;
                 if (has_prev && sweep_prev.contains(w) &&
                     in_closed_triangle(p, to, pts_[l][prev], w))
-                    return false;
+                    return true;
                 if (has_next && sweep_next.contains(w) &&
                     in_closed_triangle(p, to, pts_[l][next], w))
-                    return false;
+                    return true;
             }
+            return false;
+        };
+        if (blocker < candidates_.size() && refuses(candidates_[blocker])) return false;
+        for (std::size_t i = 0; i < candidates_.size(); ++i) {
+            if (i == blocker || !refuses(candidates_[i])) continue;
+            blocker = i;
+            return false;
         }
         return true;
     }
