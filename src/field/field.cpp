@@ -4,10 +4,13 @@
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <string>
 
 namespace strata {
@@ -140,9 +143,23 @@ SceneFields::SceneFields(const Scene& scene, const FieldParams& params,
         fields_ = std::move(grid.fields);
         return;
     }
-    fields_.reserve(scene.size());
-    for (std::size_t i = 0; i < scene.size(); ++i)
-        fields_.push_back(make_field(scene.layer(i), signs[i], params_));
+    // The layers side by side (a local untangling builds the fields of whole layers for a
+    // few percent of them: the build is most of its fixed cost); an exception is the one of
+    // the first layer that fails, as one after the other.
+    fields_.resize(scene.size());
+    std::vector<std::exception_ptr> failed(scene.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                              try {
+                                  fields_[i] = make_field(scene.layer(i), signs[i], params_);
+                              } catch (...) {
+                                  failed[i] = std::current_exception();
+                              }
+                          }
+                      });
+    for (const std::exception_ptr& e : failed)
+        if (e) std::rethrow_exception(e);
 }
 
 void SceneFields::sample_all(const Vec2& x, std::vector<FieldSample>& out) const {
