@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <optional>
 #include <tuple>
@@ -731,11 +732,26 @@ EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params
         params.sample_spacing > 0.0 ? params.sample_spacing : finest_layer_median(scene);
     const Vec2 size = scene.bounds().size();
     settings.diagonal = std::max(std::hypot(size.x, size.y), std::numeric_limits<double>::min());
-    settings.outside_signs.resize(scene.size());
-    for (std::size_t i = 0; i < scene.size(); ++i)
-        settings.outside_signs[i] = i < params.outside_sides.size() && !scene.layer(i).closed
-                                        ? params.outside_sides[i]
-                                        : outside_side(scene, i);
+    // outside_side() of the layers not given, side by side (each reads the whole scene: a
+    // local untangling's fixed cost); an exception is the first layer's, as one by one.
+    const std::size_t n = scene.size();
+    settings.outside_signs.resize(n);
+    std::vector<std::exception_ptr> failed(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                              try {
+                                  settings.outside_signs[i] =
+                                      i < params.outside_sides.size() && !scene.layer(i).closed
+                                          ? params.outside_sides[i]
+                                          : outside_side(scene, i);
+                              } catch (...) {
+                                  failed[i] = std::current_exception();
+                              }
+                          }
+                      });
+    for (const std::exception_ptr& e : failed)
+        if (e) std::rethrow_exception(e);
     return settings;
 }
 
