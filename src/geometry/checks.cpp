@@ -272,12 +272,17 @@ class Checker {
   public:
     Checker(const Scene& scene, const CheckParams& params) : scene_(scene), params_(params) {
         n_ = scene.size();
-        indices_.reserve(n_);
-        bounds_.reserve(n_);
-        for (std::size_t i = 0; i < n_; ++i) {
-            indices_.emplace_back(scene.layer(i));
-            bounds_.push_back(scene.layer(i).bounds());
-        }
+        // The layers' indices side by side: a region check (RegionCheck::check()) builds them
+        // for whole layers, at every check.
+        indices_.resize(n_);
+        bounds_.resize(n_);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                                  indices_[i] = SegmentIndex(scene.layer(i));
+                                  bounds_[i] = scene.layer(i).bounds();
+                              }
+                          });
         met_.assign(n_ * n_, 0);
         met_point_.assign(n_ * n_, Vec2(0.0));
         report_.near_distance =
