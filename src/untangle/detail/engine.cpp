@@ -149,18 +149,31 @@ std::size_t own_contacts(const std::vector<Vec2>& x, bool closed, std::size_t v,
 // layers near an edge, where a sample is needed to see them poke through a long chord. The
 // vertices sorted by cell (column, then row; in filing order within a cell), each query's
 // column one binary search: no allocation once the buffers have grown.
+//
+// The vertices of `region` are looked for among those of a larger box found at an earlier
+// build (cover_, while it holds the region), in the same (layer, vertex) order: a local
+// untangling's scene is whole while its region holds a few percent of it. Sound for the
+// engine's scenes, whose vertices move only where every region holds them (the free
+// vertices of the pieces, whose box the region grows), the others staying put.
 class VertexGrid {
   public:
     void build(const Scene& scene, const Box2& region, double cell) {
         cell_ = cell;
-        all_.clear();
-        for (std::size_t l = 0; l < scene.size(); ++l) {
-            const Layer& layer = scene.layer(l);
-            if (!layer.bounds().overlaps(region)) continue;
-            for (std::size_t v = 0; v < layer.points.size(); ++v) {
-                const Vec2& p = layer.points[v];
-                if (region.contains(p)) all_.push_back({p, l, v, coord(p.x), coord(p.y)});
+        if (!(cover_.contains(region.min) && cover_.contains(region.max))) {
+            const Vec2 size = region.size();
+            cover_ = region.inflated(0.25 * std::max(size.x, size.y));
+            candidates_.clear();
+            for (std::size_t l = 0; l < scene.size(); ++l) {
+                const Layer& layer = scene.layer(l);
+                if (!layer.bounds().overlaps(cover_)) continue;
+                for (std::size_t v = 0; v < layer.points.size(); ++v)
+                    if (cover_.contains(layer.points[v])) candidates_.push_back({l, v});
             }
+        }
+        all_.clear();
+        for (const auto& [l, v] : candidates_) {
+            const Vec2& p = scene.layer(l).points[v];
+            if (region.contains(p)) all_.push_back({p, l, v, coord(p.x), coord(p.y)});
         }
         sorted_.resize(all_.size());
         for (std::size_t k = 0; k < all_.size(); ++k) sorted_[k] = k;
@@ -206,7 +219,9 @@ class VertexGrid {
         long long column, row;
     };
     double cell_ = 1.0;
-    std::vector<Entry> all_;           // in filing order (layer, then vertex)
+    Box2 cover_;  // the box of candidates_ (empty: none yet)
+    std::vector<std::pair<std::size_t, std::size_t>> candidates_;  // (layer, vertex) in cover_
+    std::vector<Entry> all_;  // in filing order (layer, then vertex)
     std::vector<std::size_t> sorted_;  // indices into all_, by (column, row, filing order)
 };
 
