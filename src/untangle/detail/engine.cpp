@@ -558,7 +558,7 @@ class Pass {
                 moved += glm::length(d);
             }
             if (keep_simple_) keep_simple(piece, layer.closed, x, next_);
-            scene.set_points(piece.layer, next_);
+            scene.set_points(piece.layer, std::move(next_));  // next_ is refilled before use
         }
         return moved;
     }
@@ -615,7 +615,7 @@ class Pass {
             for (std::size_t k = 0; k < piece.vertices.size(); ++k)
                 next_[piece.vertices[k]] = current_[k];
             if (keep_simple_) keep_simple(piece, layer.closed, layer.points, next_);
-            scene.set_points(piece.layer, next_);
+            scene.set_points(piece.layer, std::move(next_));  // next_ is refilled before use
         }
     }
 

@@ -254,7 +254,7 @@ class Finisher {
             return result;
         }
         for (std::size_t l = 0; l < pts_.size(); ++l)
-            if (changed[l]) work_.set_points(l, pts_[l]);
+            if (changed[l]) work_.set_points(l, std::move(pts_[l]));  // pts_ is done with
         return result;
     }
 
