@@ -221,7 +221,7 @@ class VertexGrid {
     double cell_ = 1.0;
     Box2 cover_;  // the box of candidates_ (empty: none yet)
     std::vector<std::pair<std::size_t, std::size_t>> candidates_;  // (layer, vertex) in cover_
-    std::vector<Entry> all_;  // in filing order (layer, then vertex)
+    std::vector<Entry> all_;           // in filing order (layer, then vertex)
     std::vector<std::size_t> sorted_;  // indices into all_, by (column, row, filing order)
 };
 
