@@ -264,7 +264,8 @@ def untangle(
     try early when its violation, extrapolated, would not fall enough by the pass cap, as
     ``strata untangle --give-up-when-stalled``: faster failures, fewer successes;
     ``report.gave_up``). ``progress``: as in
-    :func:`simplify`, called once per round ("untangle", fraction)."""
+    :func:`simplify`, called once per round ("untangle", fraction; from the second try on,
+    "untangle, try N")."""
     return _strata._untangle(
         scene,
         dict(

@@ -8,7 +8,10 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 #include <optional>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -232,12 +235,37 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
 }
 
 }  // namespace
-UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& progress) {
-    return untangle_tries(scene, params, progress);
+namespace {
+
+// `progress` with the tries told apart: every try counts its rounds from 0 again, so a fraction
+// that does not grow starts another try, whose stage is "untangle, try N" (N from 2; a progress
+// bar that starts again says why). Empty when `progress` is.
+ProgressFn numbering_tries(const ProgressFn& progress) {
+    if (!progress) return {};
+    struct State {
+        int tries = 1;
+        double last = -1.0;
+        std::string stage;
+    };
+    auto state = std::make_shared<State>();
+    return [progress, state](std::string_view stage, double fraction) {
+        if (state->last >= 0.0 && fraction <= state->last) ++state->tries;
+        state->last = fraction;
+        if (state->tries == 1) return progress(stage, fraction);
+        state->stage = std::string(stage) + ", try " + std::to_string(state->tries);
+        return progress(state->stage, fraction);
+    };
+}
+
+}  // namespace
+
+UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& given) {
+    return untangle_tries(scene, params, numbering_tries(given));
 }
 
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
-                                        const ProgressFn& progress, InputSides* kept) {
+                                        const ProgressFn& given, InputSides* kept) {
+    const ProgressFn progress = numbering_tries(given);
     if (params.input_sides && !params.input_sides->empty())
         return with_long_rounds(
             scene, params, [](const Scene&) { return false; },  // the original's: not in question

@@ -4,12 +4,18 @@
 
 #include "strata/geometry/checks.h"
 #include "strata/geometry/input_sides.h"
+#include "strata/io/scene_io.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
 #include "strata/untangle/untangle.h"
 #include "support/fixtures.h"
 
 #include <catch2/catch.hpp>
+
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 using namespace strata;
 using test::naive_decimation;
@@ -174,4 +180,34 @@ TEST_CASE("untangle_inferring_sides: more passes for the global order's second t
     CHECK(c.is_collision_free());
     CHECK(c.separations_hold());
     CHECK(c.total_self_crossings() == 0);
+}
+
+TEST_CASE("untangle_inferring_sides: progress numbers the tries after the first", "[untangle]") {
+    // A folded stack at 95% that no try cleans (tests/data/SOURCES.md), every try giving up
+    // early: 25 tries, each reporting its rounds from the start again.
+    Scene tangled = read_scene(test::test_data("folded_stack_tangled_95.json"));
+    UntangleParams params;
+    params.give_up_when_stalled = true;
+    std::vector<std::pair<std::string, double>> calls;
+    const UntangleReport report =
+        untangle_inferring_sides(tangled, params, [&](std::string_view stage, double fraction) {
+            calls.emplace_back(std::string(stage), fraction);
+            return true;
+        });
+    REQUIRE_FALSE(report.collision_free);
+    REQUIRE(report.tries > 2);
+    REQUIRE_FALSE(calls.empty());
+    CHECK(calls.front().first == "untangle");
+    // Within a stage the fraction grows; a new stage is the next try, "untangle, try N".
+    int tries = 1;
+    for (std::size_t i = 1; i < calls.size(); ++i) {
+        if (calls[i].first == calls[i - 1].first) {
+            CHECK(calls[i].second > calls[i - 1].second);
+            continue;
+        }
+        CHECK(calls[i].first == "untangle, try " + std::to_string(++tries));
+    }
+    // Every try but those that ended before their first round reported.
+    CHECK(tries > 1);
+    CHECK(tries <= report.tries);
 }

@@ -187,7 +187,8 @@ struct UntangleReport {
 /// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
 /// global order, except where params.input_sides gives a vertex another side.
 /// @param scene     modified in place; unchanged on throw.
-/// @param progress  called once per round ("untangle", fraction); false cancels (throws Cancelled).
+/// @param progress  called once per round ("untangle", fraction; from the second try on, the
+/// stage is "untangle, try N"); false cancels (throws Cancelled).
 /// @throws InvalidInput bad params, or params.outside_sides / params.input_sides not of the
 /// scene's layer count.  @throws Cancelled.
 UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
