@@ -422,9 +422,6 @@ TEST_CASE("untangle's second try makes no self-crossing: the S-folded stack at 9
     FamilyParams p;
     p.layers = 4;
     const Scene input = make_scene(SceneFamily::Folded, p);
-    CheckParams judged;
-    judged.outside_sides = outside_sides(input);
-    judged.separation_tolerance = 0.1;
     for (unsigned seed : {1u, 2u}) {
         CAPTURE(seed);
         const Scene tangled = naive_decimation(input, 0.95, seed);
@@ -433,7 +430,7 @@ TEST_CASE("untangle's second try makes no self-crossing: the S-folded stack at 9
         const UntangleReport report = untangle(out, UntangleParams{});
         CHECK(report.collision_free);
         CHECK(report.kept_simple);  // the first try alone was not clean
-        const CheckReport c = check_scene(out, judged);
+        const CheckReport c = test::check_against(out, input);
         CHECK(c.is_collision_free());
         CHECK(c.separations_hold());
         CHECK(c.total_self_crossings() == 0);

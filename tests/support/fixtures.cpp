@@ -110,4 +110,12 @@ std::filesystem::path shared_data(const std::string& name) {
     return dir / name;
 }
 
+CheckReport check_against(const Scene& out, const Scene& original, const InputSides* sides) {
+    CheckParams judged;
+    judged.outside_sides = outside_sides(original);
+    judged.input_sides = sides;
+    judged.separation_tolerance = 0.1;
+    return check_scene(out, judged);
+}
+
 }  // namespace strata::test

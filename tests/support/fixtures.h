@@ -1,6 +1,8 @@
 #pragma once
 /// @file Generated scenes with known geometry, for the tests of every module.
 
+#include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
 #include "strata/geometry/scene.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
@@ -82,6 +84,12 @@ inline Scene collar_wrapped_cord(std::size_t points, double gap_in_segments) {
     p.gap = gap_in_segments;
     return make_scene(SceneFamily::CollarWrap, p);
 }
+
+/// check_scene() of an untangled scene `out` as the untangling tests judge it against the
+/// `original` it was decimated from: by the original's outside sides (and the `sides` recorded
+/// in it, if given), a separation passing at 0.9 x required.
+CheckReport check_against(const Scene& out, const Scene& original,
+                          const InputSides* sides = nullptr);
 
 /// tests/data/<name>
 std::filesystem::path test_data(const std::string& name);

@@ -478,10 +478,7 @@ TEST_CASE("untangle_inferring_sides: without rolled regions the inferred sides a
     CHECK_FALSE(report.long_rounds);
     CHECK(report.inferred_sides);
     CHECK(report.sides_reading == 0);
-    CheckParams judged;
-    judged.outside_sides = outside_sides(input);
-    judged.separation_tolerance = 0.1;
-    const CheckReport c = check_scene(out, judged);
+    const CheckReport c = test::check_against(out, input);
     CHECK(c.is_collision_free());
     CHECK(c.separations_hold());
     CHECK(c.total_self_crossings() == 0);

@@ -37,9 +37,6 @@ TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded 
     // (unseen by the benchmark, whose seed is 1): every try wanders for 64 passes and ends
     // tangled with 10 steps a round; with 30 they come out clean.
     const Scene input = folded_stack();
-    CheckParams judged;
-    judged.outside_sides = outside_sides(input);
-    judged.separation_tolerance = 0.1;
     for (unsigned seed : {3u}) {  // seed 8 too (docs/untangle.md), slower
         CAPTURE(seed);
         const Scene tangled = naive_decimation(input, 0.95, seed);
@@ -58,7 +55,7 @@ TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded 
         CHECK(report.passes > before.passes);  // the failed tries count too
         CHECK(report.tries > before.tries);
         CHECK(before.tries >= 2);
-        const CheckReport c = check_scene(out, judged);
+        const CheckReport c = test::check_against(out, input);
         CHECK(c.is_collision_free());
         CHECK(c.separations_hold());
         CHECK(c.total_self_crossings() == 0);
@@ -144,11 +141,7 @@ TEST_CASE(
     CHECK(report.long_rounds);
     CHECK(report.inferred_sides);
     const InputSides sides = InputSides::matched(record_input_sides(input), input, out);
-    CheckParams judged;
-    judged.outside_sides = outside_sides(input);
-    judged.input_sides = &sides;
-    judged.separation_tolerance = 0.1;
-    const CheckReport c = check_scene(out, judged);
+    const CheckReport c = test::check_against(out, input, &sides);
     CHECK(c.is_collision_free());
     CHECK(c.nesting_violation_count == 0);
 }
@@ -173,10 +166,7 @@ TEST_CASE("untangle_inferring_sides: more passes for the global order's second t
     const UntangleReport report = untangle_inferring_sides(out, params);
     CHECK(report.collision_free);
     CHECK(report.more_passes);
-    CheckParams judged;
-    judged.outside_sides = outside_sides(input);
-    judged.separation_tolerance = 0.1;
-    const CheckReport c = check_scene(out, judged);
+    const CheckReport c = test::check_against(out, input);
     CHECK(c.is_collision_free());
     CHECK(c.separations_hold());
     CHECK(c.total_self_crossings() == 0);
