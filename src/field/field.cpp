@@ -1,16 +1,14 @@
 #include "strata/field/field.h"
 
 #include "field/detail/backends.h"
+#include "geometry/detail/parallel.h"
 #include "strata/core/error.h"
 #include "strata/core/format.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <string>
 
 namespace strata {
@@ -147,19 +145,9 @@ SceneFields::SceneFields(const Scene& scene, const FieldParams& params,
     // few percent of them: the build is most of its fixed cost); an exception is the one of
     // the first layer that fails, as one after the other.
     fields_.resize(scene.size());
-    std::vector<std::exception_ptr> failed(scene.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.size(), 1),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                              try {
-                                  fields_[i] = make_field(scene.layer(i), signs[i], params_);
-                              } catch (...) {
-                                  failed[i] = std::current_exception();
-                              }
-                          }
-                      });
-    for (const std::exception_ptr& e : failed)
-        if (e) std::rethrow_exception(e);
+    detail::parallel_for_each_index(scene.size(), [&](std::size_t i) {
+        fields_[i] = make_field(scene.layer(i), signs[i], params_);
+    });
 }
 
 void SceneFields::sample_all(const Vec2& x, std::vector<FieldSample>& out) const {

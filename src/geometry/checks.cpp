@@ -1,5 +1,6 @@
 #include "strata/geometry/checks.h"
 
+#include "geometry/detail/parallel.h"
 #include "geometry/detail/region_check.h"
 #include "geometry/detail/segment_index.h"
 #include "geometry/detail/uniform_grid.h"
@@ -32,6 +33,7 @@ using detail::kSideReach;
 using detail::median_of;
 using detail::Nearest;
 using detail::nearest_on;
+using detail::parallel_for_each_index;
 using detail::segment_grid;
 using detail::SegmentIndex;
 using detail::side_at;
@@ -276,13 +278,10 @@ class Checker {
         // for whole layers, at every check.
         indices_.resize(n_);
         bounds_.resize(n_);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 1),
-                          [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                                  indices_[i] = SegmentIndex(scene.layer(i));
-                                  bounds_[i] = scene.layer(i).bounds();
-                              }
-                          });
+        parallel_for_each_index(n_, [&](std::size_t i) {
+            indices_[i] = SegmentIndex(scene.layer(i));
+            bounds_[i] = scene.layer(i).bounds();
+        });
         met_.assign(n_ * n_, 0);
         met_point_.assign(n_ * n_, Vec2(0.0));
         report_.near_distance =

@@ -2,6 +2,7 @@
 
 #include "untangle/detail/separation.h"
 
+#include "geometry/detail/parallel.h"
 #include "strata/core/error.h"
 #include "strata/geometry/checks.h"
 #include "strata/geometry/predicates.h"
@@ -16,7 +17,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <exception>
 #include <limits>
 #include <optional>
 #include <tuple>
@@ -751,22 +751,11 @@ EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params
     // local untangling's fixed cost); an exception is the first layer's, as one by one.
     const std::size_t n = scene.size();
     settings.outside_signs.resize(n);
-    std::vector<std::exception_ptr> failed(n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                              try {
-                                  settings.outside_signs[i] =
-                                      i < params.outside_sides.size() && !scene.layer(i).closed
-                                          ? params.outside_sides[i]
-                                          : outside_side(scene, i);
-                              } catch (...) {
-                                  failed[i] = std::current_exception();
-                              }
-                          }
-                      });
-    for (const std::exception_ptr& e : failed)
-        if (e) std::rethrow_exception(e);
+    parallel_for_each_index(n, [&](std::size_t i) {
+        settings.outside_signs[i] = i < params.outside_sides.size() && !scene.layer(i).closed
+                                        ? params.outside_sides[i]
+                                        : outside_side(scene, i);
+    });
     return settings;
 }
 
