@@ -359,6 +359,49 @@ TEST_CASE("sides matched by nearest vertex (strata check --reference) judge a si
     CHECK(check_scene(pushed, cp).nesting_violation_count > 0);
 }
 
+namespace {
+
+// An open layer `name` through `points`.
+Layer open_layer(const char* name, std::vector<Vec2> points) {
+    Layer layer;
+    layer.name = name;
+    layer.points = std::move(points);
+    return layer;
+}
+
+// A rolled around the end of B (y = 1, x from -1 to 9): its lower sheet (y = 0) under B, a
+// bend at (11, 1), its upper sheet (y = 2) over B back to x = 5. The reference of the first
+// two tests of InputSides::matched() below.
+Scene roll_around_end() {
+    return Scene({open_layer("a", {{0, 0},
+                                   {2, 0},
+                                   {4, 0},
+                                   {6, 0},
+                                   {8, 0},
+                                   {10, 0},
+                                   {11, 1},
+                                   {10, 2},
+                                   {9, 2},
+                                   {8, 2},
+                                   {7, 2},
+                                   {6, 2},
+                                   {5, 2}}),
+                  open_layer("b", {{-1, 1}, {1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1}})});
+}
+
+// check_scene() of `out` by the sides recorded in `reference` carried onto it without the
+// vertex correspondence (InputSides::matched(), as `strata check --reference` does), and by
+// the reference's outside sides.
+CheckReport check_matched(const Scene& out, const Scene& reference) {
+    const InputSides matched = InputSides::matched(record_input_sides(reference), reference, out);
+    CheckParams cp;
+    cp.outside_sides = outside_sides(reference);
+    cp.input_sides = &matched;
+    return check_scene(out, cp);
+}
+
+}  // namespace
+
 TEST_CASE("sides matched without the correspondence keep a moved vertex on its own sheet",
           "[rolled]") {
     // A rolled around the end of B: its lower sheet (y = 0) under B (y = 1), its upper sheet
@@ -367,45 +410,16 @@ TEST_CASE("sides matched without the correspondence keep a moved vertex on its o
     // (0.5) than its own (1.5). Its unmoved neighbours keep it between theirs (the output of
     // a simplification keeps its vertices' order), on the lower sheet: no violation; moved
     // over B it is one. Before, the nearest segment gave it the upper sheet's side, over B.
-    auto open = [](const char* name, std::vector<Vec2> points) {
-        Layer layer;
-        layer.name = name;
-        layer.points = std::move(points);
-        return layer;
-    };
-    const Layer a = open("a", {{0, 0},
-                               {2, 0},
-                               {4, 0},
-                               {6, 0},
-                               {8, 0},
-                               {10, 0},
-                               {11, 1},
-                               {10, 2},
-                               {9, 2},
-                               {8, 2},
-                               {7, 2},
-                               {6, 2},
-                               {5, 2}});
-    const Layer b = open("b", {{-1, 1}, {1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1}});
-    const Scene reference({a, b});
-    const InputSides recorded = record_input_sides(reference);
-    CheckParams cp;
-    cp.outside_sides = outside_sides(reference);
-    Layer a_out = open("a", {{0, 0}, {6, 1.5}, {10, 0}, {11, 1}, {10, 2}, {5, 2}});
-    const Layer b_out = open("b", {{-1, 1.8}, {9, 1.8}});
-    const Scene out({a_out, b_out});
-    const InputSides matched = InputSides::matched(recorded, reference, out);
-    cp.input_sides = &matched;
-    const CheckReport ok = check_scene(out, cp);
+    const Scene reference = roll_around_end();
+    Layer a_out = open_layer("a", {{0, 0}, {6, 1.5}, {10, 0}, {11, 1}, {10, 2}, {5, 2}});
+    const Layer b_out = open_layer("b", {{-1, 1.8}, {9, 1.8}});
+    const CheckReport ok = check_matched(Scene({a_out, b_out}), reference);
     CHECK(ok.crossing_count == 0);
     CHECK(ok.nesting_violation_count == 0);
 
     // Over B now (across it): the lower sheet's vertex is on the wrong side.
     a_out.points[1] = {6, 1.9};
-    const Scene wrong({a_out, b_out});
-    const InputSides matched_wrong = InputSides::matched(recorded, reference, wrong);
-    cp.input_sides = &matched_wrong;
-    const CheckReport bad = check_scene(wrong, cp);
+    const CheckReport bad = check_matched(Scene({a_out, b_out}), reference);
     CHECK(bad.nesting_violation_count > 0);
 }
 
@@ -418,46 +432,17 @@ TEST_CASE("sides matched without the correspondence keep a roll's end on its she
     // end after the bend, on the upper sheet: no violation. Before, the upper sheet was no
     // candidate, the nearest match was kept and the end was judged under B (the shirt at 95%,
     // seeds 5 and 13, and at 600 points, seed 2: the roll's end moved toward the main part).
-    auto open = [](const char* name, std::vector<Vec2> points) {
-        Layer layer;
-        layer.name = name;
-        layer.points = std::move(points);
-        return layer;
-    };
-    const Layer a = open("a", {{0, 0},
-                               {2, 0},
-                               {4, 0},
-                               {6, 0},
-                               {8, 0},
-                               {10, 0},
-                               {11, 1},
-                               {10, 2},
-                               {9, 2},
-                               {8, 2},
-                               {7, 2},
-                               {6, 2},
-                               {5, 2}});
-    const Layer b = open("b", {{-1, 1}, {1, 1}, {3, 1}, {5, 1}, {7, 1}, {9, 1}});
-    const Scene reference({a, b});
-    const InputSides recorded = record_input_sides(reference);
-    CheckParams cp;
-    cp.outside_sides = outside_sides(reference);
-    Layer a_out = open("a", {{0, 0}, {4, -0.1}, {8, -0.1}, {11.1, 1}, {10, 2.1}, {6, 0.4}});
-    const Layer b_out = open("b", {{-1, 0.2}, {8.5, 0.2}});
-    const Scene out({a_out, b_out});
-    const InputSides matched = InputSides::matched(recorded, reference, out);
-    cp.input_sides = &matched;
-    const CheckReport ok = check_scene(out, cp);
+    const Scene reference = roll_around_end();
+    Layer a_out = open_layer("a", {{0, 0}, {4, -0.1}, {8, -0.1}, {11.1, 1}, {10, 2.1}, {6, 0.4}});
+    const Layer b_out = open_layer("b", {{-1, 0.2}, {8.5, 0.2}});
+    const CheckReport ok = check_matched(Scene({a_out, b_out}), reference);
     CHECK(ok.crossing_count == 0);
     CHECK(ok.nesting_violation_count == 0);
 
     // The roll's end pulled across B, under it: a violation (the nearest match, the lower
     // sheet's side, hid it before).
     a_out.points[5] = {6, 0.1};
-    const Scene wrong({a_out, b_out});
-    const InputSides matched_wrong = InputSides::matched(recorded, reference, wrong);
-    cp.input_sides = &matched_wrong;
-    const CheckReport bad = check_scene(wrong, cp);
+    const CheckReport bad = check_matched(Scene({a_out, b_out}), reference);
     CHECK(bad.nesting_violation_count > 0);
 }
 
@@ -483,18 +468,12 @@ TEST_CASE("sides matched without the correspondence keep a run moved alike on it
     b.name = "b";
     for (int i = 0; i <= 42; ++i) b.points.push_back({-1 + 0.25 * i, 0.5});
     const Scene reference({a, b});
-    const InputSides recorded = record_input_sides(reference);
-    CheckParams cp;
-    cp.outside_sides = outside_sides(reference);
     Layer a_out = a;
     a_out.points = {{0, 0.05}, {6, 0.9}, {7, 0.92}, {8, 0.95}, {8.75, 0.99},
                     {9.3, 1.3}, {7, 1.7},  {5, 1.7}};
     Layer b_out = b;
     b_out.points = {{-1, 1.3}, {8.9, 1.3}};
-    const Scene out({a_out, b_out});
-    const InputSides matched = InputSides::matched(recorded, reference, out);
-    cp.input_sides = &matched;
-    const CheckReport ok = check_scene(out, cp);
+    const CheckReport ok = check_matched(Scene({a_out, b_out}), reference);
     CHECK(ok.crossing_count == 0);
     CHECK(ok.nesting_violation_count == 0);
 }
