@@ -375,6 +375,22 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     sided = true;
                     swapped = swapped && c != wanted;
                 }
+                // Part of such a closed layer read on the other side, the rest on the global
+                // order's: no fold of b holds any part of it either, so that part may be a
+                // tangle (a chord of b cut across it, or its vertices nearest b's roll once the
+                // decimation took the part of b between them), but a real scene can have it so
+                // (mh_elegantsuit01 at 2.5 dm: both arms in part over the ends of the sleeve
+                // pieces half wrapping them, clean as read). Another reading, the first: all
+                // of it on the global order's side.
+                if (split && large && sided && !swapped && wanted != 0) {
+                    Alternative all_global;
+                    all_global.pair = a * n_ + b;
+                    all_global.score = 2.0;  // above every region's (at most 1)
+                    for (const signed char c : s)
+                        all_global.sides.push_back(
+                            c == 1 || c == -1 ? static_cast<signed char>(wanted) : c);
+                    split->push_back(std::move(all_global));
+                }
                 if (sided && swapped) {
                     // Unless the layer turns back around b's end (turns_around_end(), within
                     // the reach of the sides): then its parts between the turns lie on b's

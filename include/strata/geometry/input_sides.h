@@ -110,7 +110,9 @@ class InputSides {
     /// a tangle) is split in two there; any other takes the side by_region() did not give it
     /// (both sides on a tie). Ordered by the share of the region's vertices the reading agrees
     /// with, less the majority's share, highest first (a split first, then the closest votes).
-    /// `outside_sides`: as by_region()'s.
+    /// With `outside_sides` (as by_region()'s), first of all: for each closed layer larger than
+    /// half open layer b's size read on the global order's side of b in part only, all of it
+    /// on that side (no fold of b holds any part of it, so the rest is likely a tangle).
     std::vector<InputSides> region_alternatives(const Scene& scene,
                                                 const std::vector<int>& outside_sides = {}) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
