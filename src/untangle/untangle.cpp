@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -92,11 +93,14 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
         CheckCounts counts;
         tbb::task_group checking;
         bool is_checking = true;
+        // With sides to keep, the input's nesting violations are all listed (rolled_kept_before).
+        CheckParams input_check_params = check_params;
+        if (has_sides) input_check_params.max_listed = std::numeric_limits<std::size_t>::max();
         checking.run([&] {
             if (region)
                 check = region_check.emplace(original, check_params, *region).reference_report();
             else
-                check = check_scene(original, check_params);
+                check = check_scene(original, input_check_params);
         });
         auto checked = [&] {
             if (!is_checking) return;
@@ -104,6 +108,13 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
             checking.wait();
             counts = counts_of(check);
             report.crossings_before = counts.crossing_count;
+            report.self_crossings_before = counts.self_crossing_count;
+            report.nesting_violations_before = counts.nesting_violation_count;
+            report.min_separation_ratio_before = counts.min_separation_ratio;
+            if (report.rolled_vertices > 0 && !region_check)
+                report.rolled_kept_before =
+                    rolled_kept(original, *params.input_sides, settings.outside_signs,
+                                report.rolled_vertices, check);
         };
         // Waits for the check of the input before leaving (it reads `original`).
         struct Waiter {
@@ -151,6 +162,8 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
         report.finishes = r.finishes;
         report.finish_moves = r.finish_moves;
         report.crossings_after = counts.crossing_count;
+        report.self_crossings_after = counts.self_crossing_count;
+        report.nesting_violations_after = counts.nesting_violation_count;
         report.min_separation_ratio_after = counts.min_separation_ratio;
         if (report.rolled_vertices > 0) {
             // The last check judged the final scene; list every violation if it did not (a

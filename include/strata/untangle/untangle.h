@@ -156,7 +156,11 @@ struct UntangleReport {
     double mean_speed = 0.0;         ///< Last round's V (Eq. 7), scene units per step.
     bool gave_up = false;            ///< Ended early by UntangleParams::give_up_when_stalled.
     std::size_t crossings_before = 0, crossings_after = 0;  ///< Between layers (check_scene).
-    double min_separation_ratio_after = 0.0;  ///< check_scene's, +inf when nothing is required.
+    std::size_t self_crossings_before = 0, self_crossings_after = 0;  ///< check_scene's.
+    /// check_scene's, judged by the sides the untangling keeps (input_sides, outside sides).
+    std::size_t nesting_violations_before = 0, nesting_violations_after = 0;
+    /// check_scene's, +inf when nothing is required.
+    double min_separation_ratio_before = 0.0, min_separation_ratio_after = 0.0;
     int finishes = 0;              ///< Runs of the finishing stage (finish_separations).
     std::size_t finish_moves = 0;  ///< Vertex moves the finishing stage made.
     double seconds_fields = 0.0, seconds_untangle = 0.0, seconds_check = 0.0;
@@ -166,6 +170,8 @@ struct UntangleReport {
     /// InputSides::rolled_count()), and of those, the ones still on that side at the end (not a
     /// nesting violation of the final check).
     std::size_t rolled_vertices = 0, rolled_kept = 0;
+    /// Of rolled_vertices, the ones on that side in the input (whole-scene untanglings only).
+    std::size_t rolled_kept_before = 0;
     /// untangle_inferring_sides(): the result kept the sides inferred per region of the input
     /// (infer_input_sides()), which has rolled regions.
     bool inferred_sides = false;
