@@ -155,6 +155,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"max_displacement", r.max_displacement},
                 {"crossings_before", r.crossings_before},
                 {"crossings_after", r.crossings_after},
+                {"self_crossings_after", after.total_self_crossings()},
                 {"nesting_violations_after", after.nesting_violation_count},
                 {"min_separation_ratio_after", std::isfinite(r.min_separation_ratio_after)
                                                    ? nlohmann::json(r.min_separation_ratio_after)
@@ -170,6 +171,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"kept_simple", r.kept_simple},
                 {"long_rounds", r.long_rounds},
                 {"more_passes", r.more_passes},
+                {"input_kept", r.input_kept},
                 {"gave_up", r.gave_up}};
             if (params.input_sides)
                 j["sides"] = {{"from", reference ? opt->reference : "inferred"},
@@ -185,7 +187,13 @@ Run add_untangle_command(CLI::App& app) {
             r.crossings_before, r.crossings_after, after.nesting_violation_count);
         if (params.input_sides) {
             std::string why;
-            if (r.sides_reading > 0)
+            if (!r.collision_free && r.inferred_sides)
+                why = r.sides_reading > 0 ? " (the least tangled try kept was by another reading "
+                                            "of the regions, number " +
+                                                std::to_string(r.sides_reading) + ")"
+                                          : " (the least tangled try kept was by the inferred "
+                                            "sides)";
+            else if (r.sides_reading > 0)
                 why =
                     " (neither the input's rolled regions as inferred nor the global order "
                     "came out clean: kept another reading of those regions, number " +
@@ -203,15 +211,20 @@ Run add_untangle_command(CLI::App& app) {
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
             "%.4g\n",
             r.min_separation_ratio_after, r.moved_vertices, r.free_vertices, r.max_displacement);
+        // Every try failed: the result is the least tangled of theirs, or the input.
+        const char* kept = r.collision_free ? ""
+                           : r.input_kept   ? " (no try less tangled: kept the input unchanged)"
+                                            : " (kept the least tangled try)";
         std::printf(
-            "tries: %d, passes: %d, rounds: %d, %s; time %.3f s (fields %.3f, untangle %.3f, "
+            "tries: %d, passes: %d, rounds: %d, %s%s; time %.3f s (fields %.3f, untangle %.3f, "
             "finish %.3f, check %.3f)\n",
             r.tries, r.passes, r.rounds,
             r.collision_free ? "collision-free"
+            : r.input_kept   ? "NOT collision-free"
             : r.gave_up      ? "NOT collision-free, gave up stalled"
             : r.converged    ? "converged, NOT collision-free"
                              : "NOT collision-free at the pass cap",
-            seconds, r.seconds_fields, r.seconds_untangle, r.seconds_finish, r.seconds_check);
+            kept, seconds, r.seconds_fields, r.seconds_untangle, r.seconds_finish, r.seconds_check);
         if (!r.collision_free) {
             std::string why;
             if (!after.self_crossings.empty()) {

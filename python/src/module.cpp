@@ -442,9 +442,12 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("max_displacement", &UntangleReport::max_displacement)
         .def_readonly("crossings_before", &UntangleReport::crossings_before)
         .def_readonly("crossings_after", &UntangleReport::crossings_after)
+        .def_readonly("self_crossings_after", &UntangleReport::self_crossings_after)
+        .def_readonly("nesting_violations_after", &UntangleReport::nesting_violations_after)
         .def_readonly("min_separation_ratio_after", &UntangleReport::min_separation_ratio_after)
         .def_readonly("inferred_sides", &UntangleReport::inferred_sides)
         .def_readonly("gave_up", &UntangleReport::gave_up)
+        .def_readonly("input_kept", &UntangleReport::input_kept)
         .def_property_readonly("seconds", [](const UntangleReport& r) {
             return r.seconds_fields + r.seconds_untangle + r.seconds_finish + r.seconds_check;
         });

@@ -150,9 +150,12 @@ class UntangleReport:
     max_displacement: float  #: Scene units.
     crossings_before: int
     crossings_after: int
+    self_crossings_after: int
+    nesting_violations_after: int
     min_separation_ratio_after: float
     inferred_sides: bool  #: The input's rolled regions kept (sides inferred per region).
     gave_up: bool  #: The result's try ended early, stalled (give_up_when_stalled).
+    input_kept: bool  #: Every try failed, none less tangled than the input: kept unchanged.
     @property
     def seconds(self) -> float: ...
 

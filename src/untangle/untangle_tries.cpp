@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -24,15 +25,6 @@ UntangleParams with_outside_sides(const Scene& scene, const UntangleParams& give
     UntangleParams params = given;
     if (params.outside_sides.empty()) params.outside_sides = untangling_outside_sides(scene);
     return params;
-}
-
-// One untangling of the whole scene; `keep_simple`: EngineSettings::keep_simple.
-UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const ProgressFn& progress,
-                             bool keep_simple) {
-    UntangleReport report =
-        detail::run_untangling(scene, whole_scene_pieces(scene), params, progress, keep_simple);
-    report.kept_simple = keep_simple;
-    return report;
 }
 
 // What the tries of one call cost (UntangleReport::tries, passes, rounds, finishes,
@@ -67,15 +59,107 @@ struct TriesCost {
     }
 };
 
+// The result kept when no try of a call comes out clean: the least tangled of the failed
+// tries' results and of the input, in this order (smaller first): crossings between layers
+// plus self-crossings, nesting violations, then the larger min separation ratio, then the
+// smaller max displacement; the earlier try on a tie, and the input only when strictly less
+// tangled than every try (a user loses nothing; docs/untangle.md, "When every try fails").
+// Each try's counts are those its final check gives (judged by the sides it kept).
+class LeastTangled {
+  public:
+    /// Stamped on the reports offered from now on (the retries' flags).
+    bool long_rounds = false, more_passes = false;
+
+    // The result of a failed try (`scene`, `report`); `sides`: the inferred sides it kept
+    // (report.inferred_sides), or nullptr for params' own.
+    // `reading`: the other reading `sides` is (report.sides_reading), 0 for none.
+    void offer(const Scene& scene, UntangleReport report, const InputSides* sides,
+               std::size_t reading) {
+        report.long_rounds = long_rounds;
+        report.more_passes = more_passes;
+        report.inferred_sides = sides != nullptr;
+        report.sides_reading = reading;
+        if (!sides && !input_) input_ = as_input(report);
+        if (scene_ && !less_tangled(report, report_)) return;
+        scene_ = scene;
+        report_ = report;
+        sides_.reset();
+        if (sides) sides_ = *sides;
+    }
+
+    // `failed` (a failed report with the cost of every try, from `input`): `scene` becomes the
+    // least tangled result, the input included, and the report is its, with that cost;
+    // `kept`, if given, receives the sides it kept when inferred.
+    UntangleReport keep(Scene& scene, const Scene& input, const UntangleReport& failed,
+                        InputSides* kept) {
+        UntangleReport report = failed;
+        if (input_ && (!scene_ || less_tangled(*input_, report_))) {
+            report = *input_;
+            scene = input;
+        } else if (scene_) {
+            report = report_;
+            scene = std::move(*scene_);
+            if (kept && sides_) *kept = std::move(*sides_);
+        }
+        scene_.reset();
+        TriesCost cost;
+        cost.add(failed);
+        return cost.charged_to(report);
+    }
+
+  private:
+    static bool less_tangled(const UntangleReport& a, const UntangleReport& b) {
+        auto key = [](const UntangleReport& r) {
+            return std::make_tuple(r.crossings_after + r.self_crossings_after,
+                                   r.nesting_violations_after, -r.min_separation_ratio_after,
+                                   r.max_displacement);
+        };
+        return key(a) < key(b);
+    }
+
+    // The input as a result, by the counts before of a try that judged it by params' sides.
+    static UntangleReport as_input(const UntangleReport& r) {
+        UntangleReport input;
+        input.free_vertices = r.free_vertices;
+        input.crossings_before = input.crossings_after = r.crossings_before;
+        input.self_crossings_before = input.self_crossings_after = r.self_crossings_before;
+        input.nesting_violations_before = input.nesting_violations_after =
+            r.nesting_violations_before;
+        input.min_separation_ratio_before = input.min_separation_ratio_after =
+            r.min_separation_ratio_before;
+        input.rolled_vertices = r.rolled_vertices;
+        input.rolled_kept = input.rolled_kept_before = r.rolled_kept_before;
+        input.input_kept = true;
+        return input;
+    }
+
+    std::optional<Scene> scene_;
+    UntangleReport report_;
+    std::optional<InputSides> sides_;
+    std::optional<UntangleReport> input_;
+};
+
+// One untangling of the whole scene; `keep_simple`: EngineSettings::keep_simple. A failed
+// result is offered to `failures` (`sides`, `reading`: LeastTangled::offer()).
+UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const ProgressFn& progress,
+                             bool keep_simple, LeastTangled& failures,
+                             const InputSides* sides = nullptr, std::size_t reading = 0) {
+    UntangleReport report =
+        detail::run_untangling(scene, whole_scene_pieces(scene), params, progress, keep_simple);
+    report.kept_simple = keep_simple;
+    if (!report.collision_free) failures.offer(scene, report, sides, reading);
+    return report;
+}
+
 // a x b for positive counts, at most INT_MAX (a pass cap or a step count a user made large).
 int saturated_product(int a, int b) {
     const long long product = static_cast<long long>(a) * static_cast<long long>(b);
     return static_cast<int>(std::min<long long>(product, std::numeric_limits<int>::max()));
 }
 
-// After a failed try (`failed`, whose result `scene` holds), another one from the input
-// (`second`, its result in `attempt`): the second result is kept when clean, the first stands
-// otherwise; the report counts both.
+// After a failed try (`failed`), another one from the input (`second`, its result in
+// `attempt`): the second result is kept when clean; otherwise the report is a failed one
+// (which result is kept, LeastTangled says). The report counts both.
 UntangleReport after_retry(Scene& scene, const UntangleReport& failed, Scene&& attempt,
                            const UntangleReport& second) {
     TriesCost cost;
@@ -107,7 +191,8 @@ bool has_rolled_regions(const Scene& scene) {
 // say it failed.
 template <class Tries, class InQuestion>
 UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params,
-                                InQuestion&& in_question_of, Tries&& tries) {
+                                InQuestion&& in_question_of, Tries&& tries,
+                                LeastTangled& failures) {
     const Scene input = scene;
     UntangleReport report = tries(scene, params, false);
     if (report.collision_free || params.long_rounds_factor <= 1) return report;
@@ -116,21 +201,22 @@ UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params,
     longer.gradient_steps = saturated_product(params.gradient_steps, params.long_rounds_factor);
     longer.long_rounds_factor = 1;
     Scene attempt = input;
+    failures.long_rounds = true;
     UntangleReport second = tries(attempt, longer, in_question);
     second.long_rounds = true;
     return after_retry(scene, report, std::move(attempt), second);
 }
 
-UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
-                              const ProgressFn& progress) {
+UntangleReport untangle_tries(Scene& scene, const UntangleParams& given, const ProgressFn& progress,
+                              LeastTangled& failures) {
     const UntangleParams params = with_outside_sides(scene, given);
     const Scene input = scene;
-    UntangleReport report = untangle_once(scene, params, progress, false);
+    UntangleReport report = untangle_once(scene, params, progress, false, failures);
     if (report.collision_free) return report;
     // Second try, from the input: no vertex move that makes a self-crossing (the projection
     // and shape matching make them, and nothing takes them out: docs/untangle.md).
     Scene simple = input;
-    const UntangleReport second = untangle_once(simple, params, progress, true);
+    const UntangleReport second = untangle_once(simple, params, progress, true, failures);
     return after_retry(scene, report, std::move(simple), second);
 }
 
@@ -138,7 +224,7 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given,
 // failed report otherwise); no global order, no other reading.
 UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
                                      const ProgressFn& progress, InputSides* kept,
-                                     bool inferred_only) {
+                                     bool inferred_only, LeastTangled& failures) {
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
     const InputSides recorded = record_input_sides(scene);
@@ -152,14 +238,13 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     // made) only when neither first try is clean, so that a scene one of them cleans costs
     // what it did without them.
     const Scene input = scene;
-    UntangleReport first;  // the global order's first try: the result when nothing is clean
-    Scene first_scene;
     TriesCost cost;
-    // One try from the input into `attempt`; true when it comes out clean.
+    // One try from the input into `attempt`; true when it comes out clean. `sides`, `reading`:
+    // what p.input_sides are when not params' (LeastTangled::offer()).
     auto clean_try = [&](const UntangleParams& p, bool keep_simple, Scene& attempt,
-                         UntangleReport& report) {
+                         UntangleReport& report, const InputSides* sides, std::size_t reading) {
         attempt = input;
-        report = untangle_once(attempt, p, progress, keep_simple);
+        report = untangle_once(attempt, p, progress, keep_simple, failures, sides, reading);
         cost.add(report);
         return report.collision_free;
     };
@@ -168,7 +253,7 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
         if (!rolled) return report;
         for (bool keep_simple : {false, true}) {
             Scene attempt;
-            if (!clean_try(with_sides, keep_simple, attempt, report)) continue;
+            if (!clean_try(with_sides, keep_simple, attempt, report, &inferred, 0)) continue;
             report.inferred_sides = true;
             if (kept) *kept = std::move(inferred);
             scene = std::move(attempt);
@@ -179,19 +264,16 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     for (bool keep_simple : {false, true}) {
         Scene attempt;
         UntangleReport report;
-        if (rolled && clean_try(with_sides, keep_simple, attempt, report)) {
+        if (rolled && clean_try(with_sides, keep_simple, attempt, report, &inferred, 0)) {
             report.inferred_sides = true;
             if (kept) *kept = std::move(inferred);
-        } else if (!clean_try(global, keep_simple, attempt, report)) {
-            if (!keep_simple) {
-                first = report;
-                first_scene = std::move(attempt);
-            }
+        } else if (!clean_try(global, keep_simple, attempt, report, nullptr, 0)) {
             // Without rolled regions the inferred sides are the global order's, but for the
             // vertices they give no side (around an end of the other layer, a tie): there only
             // the distance counts. A fold cut by the decimation (the folded scenes) can come
             // out clean so where the global order, pushing those vertices too, does not.
-            if (rolled || !clean_try(with_sides, keep_simple, attempt, report)) continue;
+            if (rolled || !clean_try(with_sides, keep_simple, attempt, report, &inferred, 0))
+                continue;
             report.inferred_sides = true;
             if (kept) *kept = std::move(inferred);
         }
@@ -216,7 +298,7 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
             p.open_cut_bends = false;
             Scene attempt;
             UntangleReport report;
-            if (!clean_try(p, keep_simple, attempt, report) ||
+            if (!clean_try(p, keep_simple, attempt, report, &others[i], i + 1) ||
                 (best < others.size() && report.max_displacement >= best_report.max_displacement))
                 continue;
             best = i;
@@ -230,8 +312,7 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
         scene = std::move(best_scene);
         return cost.charged_to(best_report);
     }
-    scene = std::move(first_scene);
-    return cost.charged_to(first);
+    return cost.charged_to(UntangleReport{});  // failed: LeastTangled keeps a result
 }
 
 }  // namespace
@@ -257,21 +338,33 @@ ProgressFn numbering_tries(const ProgressFn& progress) {
     };
 }
 
-}  // namespace
-
-UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& given) {
-    return untangle_tries(scene, params, numbering_tries(given));
+// `tries(failures)` on `scene` (they offer their failed results to `failures`): when none
+// comes out clean, the least tangled result, the input included (LeastTangled), with its
+// report; `kept` as untangle_inferring_sides(). `scene` is unchanged on throw.
+template <class Tries>
+UntangleReport clean_or_least_tangled(Scene& scene, InputSides* kept, Tries&& tries) {
+    const Scene input = scene;
+    try {
+        LeastTangled failures;
+        const UntangleReport report = tries(failures);
+        if (report.collision_free) return report;
+        return failures.keep(scene, input, report, kept);
+    } catch (...) {
+        scene = input;
+        throw;
+    }
 }
 
-UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
-                                        const ProgressFn& given, InputSides* kept) {
-    const ProgressFn progress = numbering_tries(given);
+UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& params,
+                                           const ProgressFn& progress, InputSides* kept,
+                                           LeastTangled& failures) {
     if (params.input_sides && !params.input_sides->empty())
         return with_long_rounds(
             scene, params, [](const Scene&) { return false; },  // the original's: not in question
             [&](Scene& s, const UntangleParams& p, bool /*in_question*/) {
-                return untangle_tries(s, p, progress);
-            });
+                return untangle_tries(s, p, progress, failures);
+            },
+            failures);
     const Scene input = scene;
     // has_rolled_regions(input), once, when a retry first asks.
     std::optional<bool> rolled;
@@ -280,9 +373,11 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         return *rolled;
     };
     UntangleReport report = with_long_rounds(
-        scene, params, rolled_regions, [&](Scene& s, const UntangleParams& p, bool in_question) {
-            return inferring_sides_tries(s, p, progress, kept, in_question);
-        });
+        scene, params, rolled_regions,
+        [&](Scene& s, const UntangleParams& p, bool in_question) {
+            return inferring_sides_tries(s, p, progress, kept, in_question, failures);
+        },
+        failures);
     // Every try failed: where the global order is the reading (nothing read rolled), its second
     // try (no self-crossing made) once more with more passes: the projection of a fold cut by
     // chords can wander for a few hundred passes before it comes out clean.
@@ -291,9 +386,28 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
     UntangleParams more = with_outside_sides(input, params);
     more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
     Scene attempt = input;
-    UntangleReport last = untangle_once(attempt, more, progress, true);
+    failures.long_rounds = false;
+    failures.more_passes = true;
+    UntangleReport last = untangle_once(attempt, more, progress, true, failures);
     last.more_passes = true;
     return after_retry(scene, report, std::move(attempt), last);
+}
+
+}  // namespace
+
+UntangleReport untangle(Scene& scene, const UntangleParams& params, const ProgressFn& given) {
+    const ProgressFn progress = numbering_tries(given);
+    return clean_or_least_tangled(scene, nullptr, [&](LeastTangled& failures) {
+        return untangle_tries(scene, params, progress, failures);
+    });
+}
+
+UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
+                                        const ProgressFn& given, InputSides* kept) {
+    const ProgressFn progress = numbering_tries(given);
+    return clean_or_least_tangled(scene, kept, [&](LeastTangled& failures) {
+        return inferring_sides_and_retries(scene, params, progress, kept, failures);
+    });
 }
 
 }  // namespace strata

@@ -60,6 +60,8 @@ TEST_CASE("untangle with the original's sides opens a roll's bend the decimation
         Scene dragged = tangled;
         const UntangleReport old = untangle(dragged, before);
         CHECK_FALSE((old.collision_free && is_clean(dragged)));
-        CHECK(report.max_displacement < old.max_displacement);
+        // The tries dragged the layers: further than with the bend opened, or (the collar)
+        // into a result more tangled than the input, which is then kept unchanged.
+        CHECK((old.input_kept || report.max_displacement < old.max_displacement));
     }
 }

@@ -173,7 +173,8 @@ struct UntangleReport {
     /// Of rolled_vertices, the ones on that side in the input (whole-scene untanglings only).
     std::size_t rolled_kept_before = 0;
     /// untangle_inferring_sides(): the result kept the sides inferred per region of the input
-    /// (infer_input_sides()), which has rolled regions.
+    /// (infer_input_sides()), which has rolled regions; when every try failed, the result kept
+    /// is a try by those sides (its counts are judged by them).
     bool inferred_sides = false;
     /// With inferred_sides: 0 when the kept sides are the input's regions as inferred
     /// (InputSides::by_region()); i > 0 when neither those nor the global order came out clean
@@ -188,10 +189,20 @@ struct UntangleReport {
     /// untangle_inferring_sides(): every try failed, long rounds included, and the result is
     /// the global order's second try with params.more_passes_factor times the passes.
     bool more_passes = false;
+    /// untangle(), untangle_inferring_sides(): no try came out clean and none was less tangled
+    /// than the input, which is the result, unchanged (moved_vertices 0; the counts after are
+    /// the input's). When every try fails, the result kept is the least tangled of theirs and
+    /// the input (docs/untangle.md, "When every try fails").
+    bool input_kept = false;
 };
 
 /// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
-/// global order, except where params.input_sides gives a vertex another side.
+/// global order, except where params.input_sides gives a vertex another side. When the first
+/// try is not clean, a second from the input (report.kept_simple); when neither is, the result
+/// is the least tangled of the two and the input (report.input_kept: the input, unchanged),
+/// by crossings between layers plus self-crossings, then nesting violations, then the larger
+/// min separation ratio, then the smaller max displacement; on a tie the earlier try, the input
+/// only when strictly less tangled. The report's counts after are the result's.
 /// @param scene     modified in place; unchanged on throw.
 /// @param progress  called once per round ("untangle", fraction; from the second try on, the
 /// stage is "untangle, try N"); false cancels (throws Cancelled).
@@ -218,9 +229,12 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// alone); when those fail too and nothing is read rolled, the global order's second try with
 /// params.more_passes_factor times the passes (report.more_passes). With params.input_sides given
 /// (an original's sides, not in question), untangle(), and when it fails once more with the long
-/// rounds. Same params, progress and throws as untangle(). `kept`: if given, receives the inferred
-/// sides when they were kept, for judging the result (check_scene() with them and params' outside
-/// sides, or outside_sides() of the input); left alone otherwise.
+/// rounds. When every try fails, the result is the least tangled of all their results and the
+/// input, as untangle() orders them, each try judged by the sides it untangled toward
+/// (report.inferred_sides and sides_reading say which). Same params, progress and throws as
+/// untangle(). `kept`: if given, receives the inferred sides when they were kept (a clean
+/// result's, or a failed one's), for judging the result (check_scene() with them and params'
+/// outside sides, or outside_sides() of the input); left alone otherwise.
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params = {},
                                         const ProgressFn& progress = {},
                                         InputSides* kept = nullptr);
