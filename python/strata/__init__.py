@@ -253,7 +253,8 @@ def untangle(
     by the sides inferred per region of it (``report.inferred_sides``) when that comes out
     clean, else by the global order. Returns ``(untangled scene, report)``;
     ``report.collision_free`` tells whether the result is clean (no crossing, nesting kept,
-    gaps >= 0.9 x required).
+    gaps >= 0.9 x required); when it is not, the result is the least tangled of the tries and
+    the input (``report.input_kept``: the input, unchanged).
     Parameters (``strata untangle``'s options; None: the library's default): ``backend``
     "indexed" (default), "exact" or "grid"; ``alpha`` 0.8 and ``beta`` 0.9 (shape matching,
     [0, 1]); ``gradient_steps`` 10; ``tolerance`` 1e-6 (relative to the scene diagonal);
