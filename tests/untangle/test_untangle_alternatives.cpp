@@ -585,12 +585,9 @@ TEST_CASE(
         CHECK(first.find_first_not_of('0') != std::string::npos);
         for (std::size_t k = 0; k < first.size(); ++k)
             if (first[k] != '0' && wanted[k] != '0') CHECK(first[k] == wanted[k]);
-        CheckParams scoring;
-        scoring.outside_sides = outside_sides(input);
-        scoring.input_sides = &original;
         Scene out = tangled;
         CHECK(untangle_inferring_sides(out).collision_free);
-        const CheckReport check = check_scene(out, scoring);
+        const CheckReport check = test::check_against(out, input, &original);
         CHECK(check.is_collision_free());
         CHECK(check.nesting_violation_count == 0);
     }
