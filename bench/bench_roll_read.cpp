@@ -62,7 +62,13 @@ int main(int argc, char** argv) {
         const InputSides recorded = record_input_sides(original);
         for (int i = 2; i < argc; ++i) {
             const Scene tangled = read_scene(argv[i]);
-            const InputSides wanted = recorded.renumbered(vertex_origin(original, tangled));
+            std::vector<std::vector<std::size_t>> origin;
+            try {
+                origin = vertex_origin(original, tangled);
+            } catch (const InvalidInput& e) {
+                throw InvalidInput(std::string(argv[i]) + ": " + e.what());
+            }
+            const InputSides wanted = recorded.renumbered(origin);
             const std::vector<int> read_outside = untangling_outside_sides(tangled);
             const InputSides inferred = infer_input_sides(tangled, {}, read_outside);
             std::size_t rolled = 0, kept = 0, other = 0, none = 0, differ = 0;
