@@ -1,12 +1,12 @@
 // strata_bench_roll_read: does a tangled scene still show the original's rolls?
-// For a scene decimated naively from ORIGINAL (every vertex of TANGLED is a vertex of the
-// original's same layer, in order: what `strata simplify --no-untangle` writes), compares the
-// sides `strata untangle` infers from TANGLED alone (infer_input_sides() with
-// untangling_outside_sides()) with the original's sides at the same vertices. A rolled vertex
-// is one whose original side of an open layer is not the global order's. The roll is "read"
-// when the outside sides agree with the original's and every rolled vertex is inferred on its
-// original side: the roll is still a region of the tangled scene (issue 19's "scenes where the
-// roll is a connected region"); otherwise the decimation cut it.
+// For a scene decimated naively from ORIGINAL (what `strata simplify --no-untangle` writes:
+// its vertices are the original's), compares the sides `strata untangle` infers from TANGLED
+// alone (infer_input_sides() with untangling_outside_sides()) with the original's sides at
+// the same vertices (InputSides::matched(), as `strata check --reference` takes them). A
+// rolled vertex is one whose original side of an open layer is not the global order's. The
+// roll is "read" when the outside sides agree with the original's and every rolled vertex is
+// inferred on its original side: the roll is still a region of the tangled scene (issue 19's
+// "scenes where the roll is a connected region"); otherwise the decimation cut it.
 //
 //   strata_bench_roll_read ORIGINAL TANGLED...
 //
@@ -28,25 +28,13 @@ using namespace strata;
 
 namespace {
 
-// origin[l][k]: the index in `original`'s layer l of `tangled`'s vertex k (same point, in
-// order). @throws InvalidInput when a vertex is not found.
-std::vector<std::vector<std::size_t>> vertex_origin(const Scene& original, const Scene& tangled) {
-    if (original.size() != tangled.size())
-        throw InvalidInput("the scenes have " + std::to_string(original.size()) + " and " +
-                           std::to_string(tangled.size()) + " layers");
-    std::vector<std::vector<std::size_t>> origin(tangled.size());
-    for (std::size_t l = 0; l < tangled.size(); ++l) {
-        const std::vector<Vec2>& from = original.layer(l).points;
-        std::size_t j = 0;
-        for (const Vec2& p : tangled.layer(l).points) {
-            while (j < from.size() && !(from[j].x == p.x && from[j].y == p.y)) ++j;
-            if (j == from.size())
-                throw InvalidInput("layer '" + tangled.layer(l).name +
-                                   "': a vertex that is not the original's, in order");
-            origin[l].push_back(j++);
-        }
-    }
-    return origin;
+// Throws InvalidInput naming `path` unless `scene` has `original`'s layers, by name, in order
+// (the sides are compared layer index by layer index).
+void require_same_layers(const Scene& original, const Scene& scene, const std::string& path) {
+    bool same = original.size() == scene.size();
+    for (std::size_t l = 0; same && l < scene.size(); ++l)
+        same = original.layer(l).name == scene.layer(l).name;
+    if (!same) throw InvalidInput(path + ": its layers are not the original's, by name, in order");
 }
 
 }  // namespace
@@ -62,13 +50,8 @@ int main(int argc, char** argv) {
         const InputSides recorded = record_input_sides(original);
         for (int i = 2; i < argc; ++i) {
             const Scene tangled = read_scene(argv[i]);
-            std::vector<std::vector<std::size_t>> origin;
-            try {
-                origin = vertex_origin(original, tangled);
-            } catch (const InvalidInput& e) {
-                throw InvalidInput(std::string(argv[i]) + ": " + e.what());
-            }
-            const InputSides wanted = recorded.renumbered(origin);
+            require_same_layers(original, tangled, argv[i]);
+            const InputSides wanted = InputSides::matched(recorded, original, tangled);
             const std::vector<int> read_outside = untangling_outside_sides(tangled);
             const InputSides inferred = infer_input_sides(tangled, {}, read_outside);
             std::size_t rolled = 0, kept = 0, other = 0, none = 0, differ = 0;
