@@ -170,6 +170,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"finish_moves", r.finish_moves},
                 {"kept_simple", r.kept_simple},
                 {"long_rounds", r.long_rounds},
+                {"retry_passes", r.retry_passes},
                 {"more_passes", r.more_passes},
                 {"input_kept", r.input_kept},
                 {"gave_up", r.gave_up}};

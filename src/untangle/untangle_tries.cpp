@@ -7,6 +7,7 @@
 #include "untangle/detail/run.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -68,7 +69,7 @@ struct TriesCost {
 class LeastTangled {
   public:
     /// Stamped on the reports offered from now on (the retries' flags).
-    bool long_rounds = false, more_passes = false;
+    bool long_rounds = false, retry_passes = false, more_passes = false;
 
     // The result of a failed try (`scene`, `report`); `sides`: the inferred sides it kept
     // (report.inferred_sides), or nullptr for params' own.
@@ -76,6 +77,7 @@ class LeastTangled {
     void offer(const Scene& scene, UntangleReport report, const InputSides* sides,
                std::size_t reading) {
         report.long_rounds = long_rounds;
+        report.retry_passes = retry_passes;
         report.more_passes = more_passes;
         report.inferred_sides = sides != nullptr;
         report.sides_reading = reading;
@@ -355,14 +357,41 @@ UntangleReport clean_or_least_tangled(Scene& scene, InputSides* kept, Tries&& tr
     }
 }
 
+// `all_tries(scene, params)` (every try, long rounds included); when it fails, once more from
+// the input with UntangleParams::retry_passes_factor times the passes, kept when clean (the
+// report counts both).
+template <class AllTries>
+UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, AllTries&& all_tries,
+                                 LeastTangled& failures) {
+    const Scene input = scene;
+    UntangleReport report = all_tries(scene, params);
+    if (report.collision_free) return report;
+    const double passes = std::floor(params.max_passes * params.retry_passes_factor);
+    if (!(passes > params.max_passes)) return report;
+    UntangleParams more = params;
+    more.max_passes = static_cast<int>(std::min<double>(passes, std::numeric_limits<int>::max()));
+    Scene attempt = input;
+    failures.long_rounds = false;
+    failures.retry_passes = true;
+    UntangleReport second = all_tries(attempt, more);
+    second.retry_passes = true;
+    failures.long_rounds = false;
+    return after_retry(scene, report, std::move(attempt), second);
+}
+
 UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& params,
                                            const ProgressFn& progress, InputSides* kept,
                                            LeastTangled& failures) {
     if (params.input_sides && !params.input_sides->empty())
-        return with_long_rounds(
-            scene, params, [](const Scene&) { return false; },  // the original's: not in question
-            [&](Scene& s, const UntangleParams& p, bool /*in_question*/) {
-                return untangle_tries(s, p, progress, failures);
+        return with_retry_passes(
+            scene, params,
+            [&](Scene& s, const UntangleParams& p) {
+                return with_long_rounds(
+                    s, p, [](const Scene&) { return false; },  // the original's: not in question
+                    [&](Scene& t, const UntangleParams& q, bool /*in_question*/) {
+                        return untangle_tries(t, q, progress, failures);
+                    },
+                    failures);
             },
             failures);
     const Scene input = scene;
@@ -372,10 +401,15 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
         if (!rolled) rolled = has_rolled_regions(s);
         return *rolled;
     };
-    UntangleReport report = with_long_rounds(
-        scene, params, rolled_regions,
-        [&](Scene& s, const UntangleParams& p, bool in_question) {
-            return inferring_sides_tries(s, p, progress, kept, in_question, failures);
+    UntangleReport report = with_retry_passes(
+        scene, params,
+        [&](Scene& s, const UntangleParams& p) {
+            return with_long_rounds(
+                s, p, rolled_regions,
+                [&](Scene& t, const UntangleParams& q, bool in_question) {
+                    return inferring_sides_tries(t, q, progress, kept, in_question, failures);
+                },
+                failures);
         },
         failures);
     // Every try failed: where the global order is the reading (nothing read rolled), its second
@@ -387,6 +421,7 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
     more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
     Scene attempt = input;
     failures.long_rounds = false;
+    failures.retry_passes = false;
     failures.more_passes = true;
     UntangleReport last = untangle_once(attempt, more, progress, true, failures);
     last.more_passes = true;

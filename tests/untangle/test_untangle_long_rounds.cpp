@@ -44,6 +44,7 @@ TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded 
         UntangleParams without;
         without.long_rounds_factor = 1;
         without.more_passes_factor = 1;  // the tries alone, no retry
+        without.retry_passes_factor = 1.0;
         Scene failed = tangled;
         const UntangleReport before = untangle_inferring_sides(failed, without);
         CHECK_FALSE(before.collision_free);
@@ -161,6 +162,7 @@ TEST_CASE("untangle_inferring_sides: more passes for the global order's second t
     REQUIRE(check_scene(tangled).crossing_count > 0);
     UntangleParams params;
     params.long_rounds_factor = 1;
+    params.retry_passes_factor = 1.0;
     params.other_readings = 0;
     Scene out = tangled;
     const UntangleReport report = untangle_inferring_sides(out, params);
