@@ -106,18 +106,20 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
     // counted together (the vote counts the layers under it alone unless they tie). A
     // decimation that scatters the vertices on one side leaves the other's count standing.
     std::optional<InputSides> recorded;
+    // The outside side of layer i voted by the vertices of `layers` (recorded sides within
+    // the reach of record_input_sides()): sign x side, summed.
+    auto tally = [&](const std::vector<std::size_t>& layers, int sign, std::size_t i) {
+        if (!recorded) recorded = record_input_sides(scene);
+        long vote = 0;
+        for (std::size_t j : layers)
+            for (std::size_t k = 0; k < scene.layer(j).points.size(); ++k)
+                vote += sign * recorded->side(j, k, i);
+        return vote;
+    };
     for (std::size_t i = 0; i < n; ++i) {
         if (scene.layer(i).closed || scene.inner_of(i).empty() || scene.outer_of(i).empty())
             continue;
-        if (!recorded) recorded = record_input_sides(scene);
-        auto tally = [&](const std::vector<std::size_t>& layers, int sign) {
-            long vote = 0;
-            for (std::size_t j : layers)
-                for (std::size_t k = 0; k < scene.layer(j).points.size(); ++k)
-                    vote += sign * recorded->side(j, k, i);
-            return vote;
-        };
-        const long under = tally(scene.inner_of(i), -1), over = tally(scene.outer_of(i), 1);
+        const long under = tally(scene.inner_of(i), -1, i), over = tally(scene.outer_of(i), 1, i);
         if ((under > 0 && over < 0) || (under < 0 && over > 0)) {
             const long both = under + over;
             if (both != 0) sides[i] = both > 0 ? 1 : -1;
@@ -206,10 +208,14 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
         }
     if (!linked) return sides;
     // A component whose layers' votes disagree with their parities (a tangle scatters the
-    // vertices each layer's vote counts) takes the majority of its votes, a tie its innermost
-    // layer's (the lowest index).
+    // vertices each layer's vote counts) takes the sign of the votes of all its layers'
+    // neighbours' vertices counted together (under and over each layer, times its parity),
+    // not a vote of the layers' votes: a layer whose neighbours tie (7 of 14 either way) or
+    // nearly tie votes as much as one whose neighbours all agree. A tie: the majority of the
+    // layers' votes, a tie again its innermost layer's (the lowest index).
     for (std::size_t c = 0; c < n; ++c) {
         int sum = 0, first = 0;
+        long count = 0;
         bool agree = true, any = false;
         for (std::size_t i = 0; i < n; ++i) {
             if (component[i] != c || scene.layer(i).closed) continue;
@@ -220,7 +226,11 @@ std::vector<int> untangling_outside_sides(const Scene& scene) {
             sum += vote;
         }
         if (!any || agree) continue;
-        const int chosen = sum > 0 ? 1 : sum < 0 ? -1 : first;
+        for (std::size_t i = 0; i < n; ++i)
+            if (component[i] == c && !scene.layer(i).closed)
+                count +=
+                    parity[i] * (tally(scene.inner_of(i), -1, i) + tally(scene.outer_of(i), 1, i));
+        const int chosen = count > 0 ? 1 : count < 0 ? -1 : sum > 0 ? 1 : sum < 0 ? -1 : first;
         for (std::size_t i = 0; i < n; ++i)
             if (component[i] == c && !scene.layer(i).closed) sides[i] = chosen * parity[i];
     }

@@ -23,8 +23,10 @@ namespace strata {
 /// 64 evenly spaced fractions of their lengths beyond 0.8 either way) must have the same outside
 /// side when they travel the same way and opposite ones otherwise. Where the votes of a chain
 /// of such layers disagree (in a scene tangled by decimation, a layer's vote counts the
-/// neighbours' vertices scattered on both sides of it), every layer of the chain takes the
-/// majority of the chain's votes (a tie: its lowest-index layer's). Where they agree (an
+/// neighbours' vertices scattered on both sides of it), every layer of the chain takes the sign
+/// of all those neighbours' votes counted together (each vertex of a layer directly under or
+/// over one of the chain's layers, by its recorded side, times the layer's parity in the chain;
+/// a tie: the majority of the layers' votes, then its lowest-index layer's). Where they agree (an
 /// untangled scene), they are returned as they are. Layers with a rolled part run along each
 /// other less (0.38-0.65 on strata_bench_untangle's rolled families) and are left to their
 /// own votes. First of all, an open layer with neighbours both under and over it whose
