@@ -60,6 +60,46 @@ bool meets(const Vec2& p, const Vec2& q, const Layer& b) {
     return false;
 }
 
+// Whether segments (p, q) and (u, w) of a layer other than `b` both meet one segment of b.
+bool meet_same_segment(const Vec2& p, const Vec2& q, const Vec2& u, const Vec2& w, const Layer& b) {
+    const std::size_t m = b.points.size();
+    const std::size_t segments = b.closed ? m : (m > 0 ? m - 1 : 0);
+    for (std::size_t j = 0; j < segments; ++j) {
+        const Vec2& x = b.points[j];
+        const Vec2& y = b.points[(j + 1) % m];
+        if (segment_contact(p, q, x, y) != SegmentContact::None &&
+            segment_contact(u, w, x, y) != SegmentContact::None)
+            return true;
+    }
+    return false;
+}
+
+// The recorded sides `s` of open `layer` against open `b` with every poke taken back: a run
+// of consecutive vertices on one side, entered and left by segments that meet one and the same
+// segment of b (a chord of b cut across the layer, or the layer poked through b), takes the
+// side of the vertices around it. A roll goes around b's end, a cut bend crosses b once.
+std::vector<signed char> without_pokes(const Layer& layer, const Layer& b,
+                                       const std::vector<signed char>& s) {
+    std::vector<signed char> out = s;
+    const std::size_t n = s.size();
+    if (layer.closed || b.closed) return out;
+    auto sided = [&](std::size_t k) { return s[k] == 1 || s[k] == -1; };
+    for (std::size_t i = 1; i + 1 < n;) {
+        if (!sided(i) || !sided(i - 1) || s[i - 1] == s[i]) {
+            ++i;
+            continue;
+        }
+        std::size_t j = i;
+        while (j + 1 < n && s[j + 1] == s[i]) ++j;
+        if (j + 1 < n && s[j + 1] == s[i - 1] &&
+            meet_same_segment(layer.points[i - 1], layer.points[i], layer.points[j],
+                              layer.points[j + 1], b))
+            for (std::size_t k = i; k <= j; ++k) out[k] = s[i - 1];
+        i = j + 1;
+    }
+    return out;
+}
+
 // A region of InputSides::by_region(): `count` consecutive vertices of a layer from `first`
 // (wrapping around a closed layer), with `plus` and `minus` of them recorded on each side.
 struct Region {
@@ -254,6 +294,7 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
             // turns_around_end() of the layer around b's ends, when first needed (by both rules
             // below).
             std::optional<std::vector<std::size_t>> turns;
+            std::optional<std::vector<signed char>> unpoked;  // without_pokes(), when needed
             auto turns_of = [&]() -> const std::vector<std::size_t>& {
                 if (!turns) {
                     if (near < 0.0) near = automatic_near_distance(scene);
@@ -277,6 +318,18 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                 }
                 for (std::size_t c = 0; c < r.count; ++c) s[(r.first + c) % n] = side;
                 if (!split || r.plus == 0 || r.minus == 0) continue;
+                // No split where the disagreeing vertices are pokes (without_pokes()).
+                bool poked_only = false;
+                if (!layer.closed && !scene.layer(b).closed) {
+                    if (!unpoked) unpoked = without_pokes(layer, scene.layer(b), recorded);
+                    std::size_t plus = 0, minus = 0;
+                    for (std::size_t c = 0; c < r.count; ++c) {
+                        const signed char v = (*unpoked)[(r.first + c) % n];
+                        plus += v == 1;
+                        minus += v == -1;
+                    }
+                    poked_only = plus == 0 || minus == 0;
+                }
                 // The region read otherwise: an open layer's region split in two where the
                 // two runs fit the recorded sides best, if that fits better than one side.
                 const std::size_t one = std::max(r.plus, r.minus);
@@ -310,6 +363,7 @@ std::vector<std::vector<signed char>> InputSides::region_codes(
                     for (std::size_t c = 0; c < r.count; ++c) alt.sides.push_back(side_at(c));
                     split->push_back(std::move(alt));
                 };
+                if (cut > 0 && poked_only) continue;
                 if (cut > 0)
                     add(best, [&](std::size_t c) { return c < cut ? before : after; });
                 else if (side != 0)  // otherwise the other side

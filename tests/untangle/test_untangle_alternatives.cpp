@@ -56,6 +56,38 @@ TEST_CASE("region_alternatives: a roll whose bend was cut across the other layer
           sides_of(recorded.by_region(scene), scene, 1, 0));
 }
 
+TEST_CASE("region_alternatives: no split of a run poked through one segment", "[untangle][sides]") {
+    // b: an open layer along y = 0 whose segment from x = 2 to x = 8 is one chord (the
+    // decimation took the vertices between). a: under it (y < 0) but for 4 vertices over it
+    // entered and left across that one segment of b: b's chord cut across a (or a poked
+    // through b), not a roll whose bend the decimation cut (that crosses b once).
+    Layer b;
+    b.name = "b";
+    b.points = {{0.0, 0.0}, {2.0, 0.0}, {8.0, 0.0}, {10.0, 0.0}};
+    Layer a;
+    a.name = "a";
+    a.points = {{0.5, -0.3}, {1.0, -0.3}, {1.5, -0.3}, {2.5, -0.3}, {3.0, -0.3},
+                {4.0, 0.2},  {5.0, 0.2},  {6.0, 0.2},  {7.0, 0.2},  {7.5, -0.3}};
+    const Scene scene({a, b});  // a under b (file order)
+    const InputSides recorded = record_input_sides(scene);
+    REQUIRE(sides_of(recorded, scene, 0, 1) == "+++++----+");
+    CHECK(sides_of(recorded.by_region(scene), scene, 0, 1) == "++++++++++");
+    auto split_off = [](const std::vector<InputSides>& others, const Scene& s) {
+        for (const InputSides& other : others)
+            if (sides_of(other, s, 0, 1) == "+++++-----") return true;
+        return false;
+    };
+    CHECK(!split_off(recorded.region_alternatives(scene), scene));
+    // Entered and left across two segments of b: split off (the run and the vertex after it),
+    // as a roll whose bend the decimation cut.
+    Layer c = b;
+    c.points = {{0.0, 0.0}, {2.0, 0.0}, {5.5, 0.0}, {8.0, 0.0}, {10.0, 0.0}};
+    const Scene two_chords({a, c});
+    const InputSides recorded_two = record_input_sides(two_chords);
+    REQUIRE(sides_of(recorded_two, two_chords, 0, 1) == "+++++----+");
+    CHECK(split_off(recorded_two.region_alternatives(two_chords), two_chords));
+}
+
 TEST_CASE("region_alternatives: none where every region's vertices agree", "[untangle][sides]") {
     FamilyParams p;
     p.points = 60;

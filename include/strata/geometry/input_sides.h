@@ -107,12 +107,15 @@ class InputSides {
     /// by_region() with that one region read otherwise. A region of an open layer whose
     /// recorded sides two runs fit better than one side (the most vertices agreeing, e.g. a
     /// roll whose bend the decimation cut across the other layer, which by_region() takes for
-    /// a tangle) is split in two there; any other takes the side by_region() did not give it
-    /// (both sides on a tie). Ordered by the share of the region's vertices the reading agrees
-    /// with, less the majority's share, highest first (a split first, then the closest votes).
-    /// With `outside_sides` (as by_region()'s), first of all: for each closed layer larger than
-    /// half open layer b's size read on the global order's side of b in part only, all of it
-    /// on that side (no fold of b holds any part of it, so the rest is likely a tangle).
+    /// a tangle) is split in two there, unless its vertices disagree only by pokes (a run on
+    /// the other side of b entered and left across one and the same segment of b: b's chord
+    /// cut across the layer, not a cut bend, which crosses b once), then it is not read
+    /// otherwise; any other takes the side by_region() did not give it (both sides on a tie).
+    /// Ordered by the share of the region's vertices the reading agrees with, less the majority's
+    /// share, highest first (a split first, then the closest votes). With `outside_sides` (as
+    /// by_region()'s), first of all: for each closed layer larger than half open layer b's size
+    /// read on the global order's side of b in part only, all of it on that side (no fold of b
+    /// holds any part of it, so the rest is likely a tangle).
     std::vector<InputSides> region_alternatives(const Scene& scene,
                                                 const std::vector<int>& outside_sides = {}) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
