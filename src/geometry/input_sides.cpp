@@ -169,14 +169,10 @@ ClosestSegment closest_segment(const std::vector<Vec2>& q, const Vec2& p) {
     return out;
 }
 
-// The side of open layer `other` that the centroid of closed `layer`'s vertices lies on, by
-// the rule of record_input_sides() (the side at the closest point; at a corner, the side of
-// the corner's wedge); 0 when the closest point is an end point of `other`.
-signed char centroid_side(const Layer& layer, const Layer& other) {
-    Vec2 centre(0.0);
-    for (const Vec2& p : layer.points) centre += p;
-    centre /= static_cast<double>(layer.points.size());
-    const std::vector<Vec2>& q = other.points;
+// The side of open polyline `q` that `centre` lies on, by the rule of record_input_sides()
+// (the side at the closest point; at a corner, the side of the corner's wedge); 0 when the
+// closest point is an end point of `q`.
+signed char polyline_side(const std::vector<Vec2>& q, const Vec2& centre) {
     if (q.size() < 2) return 0;
     const auto [segment, at] = closest_segment(q, centre);
     if ((segment == 0 && at <= 0.0) || (segment + 2 == q.size() && at >= 1.0)) return 0;
@@ -188,6 +184,15 @@ signed char centroid_side(const Layer& layer, const Layer& other) {
     else
         side = segment_side(q[segment], q[segment + 1], centre);
     return static_cast<signed char>(side);
+}
+
+// The side of open layer `other` that the centroid of closed `layer`'s vertices lies on
+// (polyline_side()).
+signed char centroid_side(const Layer& layer, const Layer& other) {
+    Vec2 centre(0.0);
+    for (const Vec2& p : layer.points) centre += p;
+    centre /= static_cast<double>(layer.points.size());
+    return polyline_side(other.points, centre);
 }
 
 // The side of open layer `other` that closed `layer`'s vertices lie on by every part of
@@ -655,6 +660,56 @@ std::size_t InputSides::vertex_count(std::size_t a) const {
     if (!origin_.empty()) return origin_[a].size();
     const std::size_t r = layer_.empty() ? a : layer_[a];
     return r == kNoLayer ? 0 : recorded_->scene.layer(r).points.size();
+}
+
+InputSides InputSides::off_other_sheets(const Scene& scene) const {
+    if (empty()) return {};
+    if (scene.size() != n_)
+        throw InvalidInput("input sides: off_other_sheets() got " + std::to_string(scene.size()) +
+                           " layers for " + std::to_string(n_));
+    const Recorded& rec = *recorded_;
+    std::vector<std::vector<signed char>> codes(n_ * n_);
+    std::vector<std::unique_ptr<SegmentIndex>> indices(n_);
+    for (std::size_t a = 0; a < n_; ++a)
+        for (std::size_t b = 0; b < n_; ++b) {
+            if (a == b || scene.layer(b).closed || scene.layer(b).points.size() < 2) continue;
+            const std::vector<Vec2>& points = scene.layer(a).points;
+            std::vector<signed char>& out = codes[a * n_ + b];
+            for (std::size_t k = 0; k < points.size(); ++k) {
+                const int c = code(a, k, b);
+                if (c == 0 && out.empty()) continue;
+                out.resize(points.size(), 0);
+                out[k] = static_cast<signed char>(c);
+                if (c != 1 && c != -1) continue;
+                if (!indices[b]) indices[b] = std::make_unique<SegmentIndex>(scene.layer(b));
+                const Nearest now = nearest_on(*indices[b], points[k]);
+                if (side_of(*indices[b], points[k], now) != -c) continue;
+                // The recorded vertex and its closest segment of b there.
+                std::size_t ra = a, rb = b, rk = k;
+                if (!layer_.empty()) ra = layer_[a], rb = layer_[b];
+                if (!origin_.empty()) rk = origin_[a][k];
+                if (rk >= rec.scene.layer(ra).points.size()) continue;
+                const Vec2 rp = rec.scene.layer(ra).points[rk];
+                const SegmentIndex& rindex = rec.index(rb);
+                const Nearest then = nearest_on(rindex, rp);
+                if (!now.found() || !then.found()) continue;
+                const Vec2 d_now = indices[b]->end(now.segment) - indices[b]->start(now.segment);
+                const Vec2 d_then = rindex.end(then.segment) - rindex.start(then.segment);
+                if (glm::dot(d_now, d_then) >= 0.0) continue;
+                // The stretch of b in the recorded scene between the recorded vertices of the
+                // ends of that segment: a vertex between a fold's sheets (a roll's jacket) has
+                // its side of both, and keeps it; one outside the fold does not.
+                std::size_t lo = now.segment, hi = now.segment + 1;
+                if (!origin_.empty()) lo = origin_[b][lo], hi = origin_[b][hi];
+                if (lo > hi) std::swap(lo, hi);
+                const std::vector<Vec2>& rq = rec.scene.layer(rb).points;
+                if (hi >= rq.size()) continue;
+                const std::vector<Vec2> stretch(rq.begin() + static_cast<std::ptrdiff_t>(lo),
+                                                rq.begin() + static_cast<std::ptrdiff_t>(hi) + 1);
+                if (polyline_side(stretch, rp) == -c) out[k] = kBeyondEnd;
+            }
+        }
+    return from_codes(scene, std::move(codes));
 }
 
 namespace {

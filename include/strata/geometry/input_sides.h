@@ -70,6 +70,18 @@ class InputSides {
     /// own sheet where the order says so). Layers without a namesake get none.
     static InputSides matched(const InputSides& recorded, const Scene& reference,
                               const Scene& scene);
+    /// These sides (recorded in another scene, e.g. matched()'s) for `scene`, the scene they
+    /// are for, except that a vertex of layer a whose side of open layer b in `scene` is not
+    /// its recorded one, whose closest segment of b in `scene` runs against the one closest to
+    /// its recorded vertex in the recorded scene (negative dot product of the directions), and
+    /// whose recorded vertex has the other side of the stretch of b between the recorded
+    /// vertices of that segment's ends, gets no side of b, as around b's end: it lies outside a
+    /// fold of b that the decimation closed, nearer the fold's other sheet than its own, and
+    /// its side read at that sheet asks for the wrong side of both sheets. (A vertex between
+    /// the sheets, such as a jacket's end in a shirt's roll, has the same side of both and
+    /// keeps it.) Sides as codes of `scene` (no query later).
+    /// @throws InvalidInput a scene of another layer count.
+    InputSides off_other_sheets(const Scene& scene) const;
     /// The same sides made consistent along each layer, for sides recorded in a scene that is
     /// itself tangled (`scene`, the one recorded): the vertices of layer a with a side of open
     /// layer b fall into regions, runs of consecutive vertices joined by a segment that keeps
