@@ -24,16 +24,6 @@ namespace strata::cli {
 
 namespace {
 
-// Vertex sides of `scene` that `every` has and `kept` leaves out (once per other layer).
-std::size_t sides_left_out(const Scene& scene, const InputSides& every, const InputSides& kept) {
-    std::size_t count = 0;
-    for (std::size_t a = 0; a < scene.size(); ++a)
-        for (std::size_t b = 0; b < scene.size(); ++b)
-            for (std::size_t k = 0; k < scene.layer(a).points.size(); ++k)
-                count += every.side(a, k, b) != 0 && kept.side(a, k, b) == 0;
-    return count;
-}
-
 struct UntangleOptions {
     std::string input, output, svg, report, reference;
     double thickness = 0.0;
@@ -110,17 +100,11 @@ Run add_untangle_command(CLI::App& app) {
         // The original's sides of its open layers (or the input's own, per region), kept
         // where they are not the global order's.
         std::optional<Reference> reference;
-        InputSides inferred, every_side;
-        std::size_t left_out = 0;
+        InputSides inferred;
         CheckParams check_params;
         if (!opt->reference.empty()) {
             reference = read_reference(opt->reference, input, 0.0, true, opt->thickness);
             params.outside_sides = reference->outside_sides;
-            // First without the sides read at a fold's other sheet (InputSides::
-            // off_other_sheets(), docs/untangle.md); when that fails, every matched side.
-            every_side = std::move(reference->sides);
-            reference->sides = every_side.off_other_sheets(input);
-            left_out = sides_left_out(input, every_side, reference->sides);
             params.input_sides = &reference->sides;  // untangling keeps the vertex indices
         } else if (opt->infer_sides) {
             params.outside_sides = untangling_outside_sides(input);
@@ -139,32 +123,14 @@ Run add_untangle_command(CLI::App& app) {
         // the first tries fail), the tries of untangle_inferring_sides(); --global-order and
         // --infer-sides: one untangle().
         const bool fallback = !opt->global_order && !opt->infer_sides;
-        UntangleReport r =
+        const UntangleReport r =
             fallback ? untangle_inferring_sides(scene, params, terminal_progress(), &inferred)
                      : untangle(scene, params, terminal_progress());
-        if (reference && left_out > 0 && !r.collision_free) {
-            // Not clean without the sides left out: every matched side, from the input, and
-            // that result whether clean or not (what came before the sides were left out).
-            reference->sides = std::move(every_side);
-            left_out = 0;
-            Scene again = input;
-            UntangleReport second =
-                untangle_inferring_sides(again, params, terminal_progress(), &inferred);
-            second.tries += r.tries;
-            second.passes += r.passes;
-            second.rounds += r.rounds;
-            second.finishes += r.finishes;
-            second.finish_moves += r.finish_moves;
-            second.seconds_fields += r.seconds_fields;
-            second.seconds_untangle += r.seconds_untangle;
-            second.seconds_finish += r.seconds_finish;
-            second.seconds_check += r.seconds_check;
-            r = second;
-            scene = std::move(again);
-        }
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (r.inferred_sides) {  // the input's rolled regions were kept, `inferred` holds them
+        // The input's rolled regions were kept, or the original's sides but those read at a
+        // fold's other sheet (InputSides::off_other_sheets()): `inferred` holds them.
+        if (r.inferred_sides || r.sides_left_out > 0) {
             params.input_sides = &inferred;
             check_params.input_sides = &inferred;
         }
@@ -215,7 +181,7 @@ Run add_untangle_command(CLI::App& app) {
                               {"rolled_vertices", r.rolled_vertices},
                               {"rolled_kept", r.rolled_kept},
                               {"reading", r.sides_reading}};
-            if (reference) j["sides"]["left_out"] = left_out;
+            if (reference) j["sides"]["left_out"] = r.sides_left_out;
             write_file_atomic(opt->report, json_report_text(j) + "\n");
         }
         std::printf("%s -> %s: %zu layers, %zu vertices\n", opt->input.c_str(), opt->output.c_str(),

@@ -379,21 +379,64 @@ UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, All
     return after_retry(scene, report, std::move(attempt), second);
 }
 
+// Vertex sides of `scene` that `every` gives and `kept` leaves out (once per other layer).
+std::size_t sides_left_out(const Scene& scene, const InputSides& every, const InputSides& kept) {
+    std::size_t count = 0;
+    for (std::size_t a = 0; a < scene.size(); ++a)
+        for (std::size_t b = 0; b < scene.size(); ++b)
+            for (std::size_t k = 0; k < scene.layer(a).points.size(); ++k)
+                count += every.side(a, k, b) != 0 && kept.side(a, k, b) == 0;
+    return count;
+}
+
+// With params.input_sides given (an original's, not in question): untangle()'s tries, long
+// rounds and the retry with more passes, first without the sides read at a fold's other sheet
+// (InputSides::off_other_sheets(): `kept` receives those sides when that is clean), then, when
+// some are left out and that is not clean, with every side from the input (the report counts
+// both). Only the tries with every side offer their failed results to `failures`: the others
+// are judged by fewer sides.
+UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
+                                    const ProgressFn& progress, InputSides* kept,
+                                    LeastTangled& failures) {
+    auto all_tries = [&](Scene& s, const UntangleParams& p, LeastTangled& f) {
+        return with_retry_passes(
+            s, p,
+            [&](Scene& t, const UntangleParams& q) {
+                return with_long_rounds(
+                    t, q, [](const Scene&) { return false; },  // the original's: not in question
+                    [&](Scene& u, const UntangleParams& r, bool /*in_question*/) {
+                        return untangle_tries(u, r, progress, f);
+                    },
+                    f);
+            },
+            f);
+    };
+    InputSides fewer = params.input_sides->off_other_sheets(scene);
+    const std::size_t left_out = sides_left_out(scene, *params.input_sides, fewer);
+    if (left_out == 0) return all_tries(scene, params, failures);
+    UntangleParams without = params;
+    without.input_sides = &fewer;
+    Scene attempt = scene;
+    LeastTangled not_offered;
+    UntangleReport first = all_tries(attempt, without, not_offered);
+    if (first.collision_free) {
+        first.sides_left_out = left_out;
+        scene = std::move(attempt);
+        if (kept) *kept = std::move(fewer);
+        return first;
+    }
+    UntangleReport second = all_tries(scene, params, failures);
+    TriesCost cost;
+    cost.add(first);
+    cost.add(second);
+    return cost.charged_to(second);
+}
+
 UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& params,
                                            const ProgressFn& progress, InputSides* kept,
                                            LeastTangled& failures) {
     if (params.input_sides && !params.input_sides->empty())
-        return with_retry_passes(
-            scene, params,
-            [&](Scene& s, const UntangleParams& p) {
-                return with_long_rounds(
-                    s, p, [](const Scene&) { return false; },  // the original's: not in question
-                    [&](Scene& t, const UntangleParams& q, bool /*in_question*/) {
-                        return untangle_tries(t, q, progress, failures);
-                    },
-                    failures);
-            },
-            failures);
+        return original_sides_tries(scene, params, progress, kept, failures);
     const Scene input = scene;
     // has_rolled_regions(input), once, when a retry first asks.
     std::optional<bool> rolled;

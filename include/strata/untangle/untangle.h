@@ -207,6 +207,10 @@ struct UntangleReport {
     /// the input's). When every try fails, the result kept is the least tangled of theirs and
     /// the input (docs/untangle.md, "When every try fails").
     bool input_kept = false;
+    /// untangle_inferring_sides() with params.input_sides: how many vertex sides (one per
+    /// vertex and other layer) the result kept leaves out, the sides read at a fold's other
+    /// sheet (InputSides::off_other_sheets()); 0 when it kept every side.
+    std::size_t sides_left_out = 0;
 };
 
 /// @brief Untangles the whole scene (the global mode): every vertex may move. Layers keep the
@@ -244,7 +248,10 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// order's second try with params.more_passes_factor times the passes (report.more_passes). With
 /// params.input_sides given (an original's sides, not in question), untangle(), when it fails
 /// once more with the long rounds, and when those fail all of that with
-/// params.retry_passes_factor times the passes. When every try fails, the result is the least
+/// params.retry_passes_factor times the passes; all of that first without the sides read at a
+/// fold's other sheet (InputSides::off_other_sheets(); report.sides_left_out, `kept` those
+/// sides), then, when some were left out and that is not clean, with every side. When every
+/// try fails, the result is the least
 /// tangled of all their results and the input, as untangle() orders them, each try judged by the
 /// sides it untangled toward (report.inferred_sides and sides_reading say which). Same params,
 /// progress and throws as untangle(). `kept`: if given, receives the inferred sides when they were
