@@ -357,14 +357,18 @@ UntangleReport clean_or_least_tangled(Scene& scene, InputSides* kept, Tries&& tr
     }
 }
 
-// `all_tries(scene, params)` (every try, long rounds included); when it fails, once more from
-// the input with UntangleParams::retry_passes_factor times the passes, kept when clean (the
-// report counts both).
-template <class AllTries>
+// `all_tries(scene, params)` (every try, long rounds included); when it fails,
+// `cheaper(scene, failed)` (a last try that costs less than all of them again: returns its
+// report, or `failed`), then, when that fails too, all the tries once more from the input with
+// UntangleParams::retry_passes_factor times the passes, kept when clean (the report counts
+// every try).
+template <class AllTries, class Cheaper>
 UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, AllTries&& all_tries,
-                                 LeastTangled& failures) {
+                                 Cheaper&& cheaper, LeastTangled& failures) {
     const Scene input = scene;
     UntangleReport report = all_tries(scene, params);
+    if (report.collision_free) return report;
+    report = cheaper(scene, report);
     if (report.collision_free) return report;
     const double passes = std::floor(params.max_passes * params.retry_passes_factor);
     if (!(passes > params.max_passes)) return report;
@@ -372,6 +376,7 @@ UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, All
     more.max_passes = static_cast<int>(std::min<double>(passes, std::numeric_limits<int>::max()));
     Scene attempt = input;
     failures.long_rounds = false;
+    failures.more_passes = false;
     failures.retry_passes = true;
     UntangleReport second = all_tries(attempt, more);
     second.retry_passes = true;
@@ -409,7 +414,7 @@ UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
                     },
                     f);
             },
-            f);
+            [](Scene&, const UntangleReport& failed) { return failed; }, f);
     };
     InputSides fewer = params.input_sides->off_other_sheets(scene);
     const std::size_t left_out = sides_left_out(scene, *params.input_sides, fewer);
@@ -444,7 +449,23 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
         if (!rolled) rolled = has_rolled_regions(s);
         return *rolled;
     };
-    UntangleReport report = with_retry_passes(
+    // Every try failed: where the global order is the reading (nothing read rolled), its second
+    // try (no self-crossing made) once more with more passes, before all the tries once more:
+    // the projection of a fold cut by chords can wander for a few hundred passes before it comes
+    // out clean.
+    auto more_passes = [&](Scene& s, const UntangleReport& failed) {
+        if (params.more_passes_factor <= 1 || rolled_regions(input)) return failed;
+        UntangleParams more = with_outside_sides(input, params);
+        more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
+        Scene attempt = input;
+        failures.long_rounds = false;
+        failures.more_passes = true;
+        UntangleReport last = untangle_once(attempt, more, progress, true, failures);
+        last.more_passes = true;
+        failures.more_passes = false;
+        return after_retry(s, failed, std::move(attempt), last);
+    };
+    return with_retry_passes(
         scene, params,
         [&](Scene& s, const UntangleParams& p) {
             return with_long_rounds(
@@ -454,21 +475,7 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
                 },
                 failures);
         },
-        failures);
-    // Every try failed: where the global order is the reading (nothing read rolled), its second
-    // try (no self-crossing made) once more with more passes: the projection of a fold cut by
-    // chords can wander for a few hundred passes before it comes out clean.
-    if (report.collision_free || params.more_passes_factor <= 1 || rolled_regions(input))
-        return report;
-    UntangleParams more = with_outside_sides(input, params);
-    more.max_passes = saturated_product(params.max_passes, params.more_passes_factor);
-    Scene attempt = input;
-    failures.long_rounds = false;
-    failures.retry_passes = false;
-    failures.more_passes = true;
-    UntangleReport last = untangle_once(attempt, more, progress, true, failures);
-    last.more_passes = true;
-    return after_retry(scene, report, std::move(attempt), last);
+        more_passes, failures);
 }
 
 }  // namespace

@@ -95,19 +95,20 @@ struct UntangleParams {
     /// reading let a wrong reading hold). untangle() itself does not retry. docs/untangle.md,
     /// "Longer rounds when every try fails".
     int long_rounds_factor = 3;
-    /// untangle_inferring_sides() only: when every try fails, long rounds included, all of
-    /// them (as above, long rounds too) run once more from the input with max_passes x this
-    /// factor (rounded down); the first clean result of those is kept. The projection of a
-    /// fold cut by chords can wander for more than max_passes passes before it comes out clean,
-    /// under any reading; more passes for every try from the start would let wrong readings
-    /// hold that fewer passes leave failing (docs/untangle.md, "More passes when every try
+    /// untangle_inferring_sides() only: when every try fails, long rounds and more_passes_factor's
+    /// retry included, all of them (as above, long rounds too) run once more from the input with
+    /// max_passes x this factor (rounded down); the first clean result of those is kept. The
+    /// projection of a fold cut by chords can wander for more than max_passes passes before it
+    /// comes out clean, under any reading; more passes for every try from the start would let wrong
+    /// readings hold that fewer passes leave failing (docs/untangle.md, "More passes when every try
     /// fails"). <= 1 (or max_passes x this below max_passes + 1): no such retry.
     double retry_passes_factor = 1.5;
     /// untangle_inferring_sides() without params.input_sides only, for a scene without rolled
     /// regions by its inferred sides (the global order is its reading): when every try has
-    /// failed, long rounds and retry_passes_factor's retry included, the global order's second
-    /// try (no self-crossing made) runs once more from the input with max_passes x this factor
-    /// (the projection of a fold cut by chords wanders for a while before it comes out clean).
+    /// failed, long rounds included (before retry_passes_factor's retry), the global order's
+    /// second try (no self-crossing made) runs once more from the input with max_passes x this
+    /// factor (the projection of a fold cut by chords wanders for a while before it comes out
+    /// clean).
     /// <= 1: no such retry.
     /// docs/untangle.md, "More passes when every try fails".
     int more_passes_factor = 4;
@@ -195,12 +196,12 @@ struct UntangleReport {
     /// untangle_inferring_sides(): every try with params.gradient_steps failed, and the result
     /// is that of the retry with params.long_rounds_factor times as many.
     bool long_rounds = false;
-    /// untangle_inferring_sides(): every try failed, long rounds included, and the result is
-    /// that of their retry with params.retry_passes_factor times the passes.
+    /// untangle_inferring_sides(): every try failed, long rounds and the more_passes retry
+    /// included, and the result is that of their retry with params.retry_passes_factor times
+    /// the passes.
     bool retry_passes = false;
-    /// untangle_inferring_sides(): every try failed, long rounds and the retry with more passes
-    /// included, and the result is the global order's second try with
-    /// params.more_passes_factor times the passes.
+    /// untangle_inferring_sides(): every try failed, long rounds included, and the result is the
+    /// global order's second try with params.more_passes_factor times the passes.
     bool more_passes = false;
     /// untangle(), untangle_inferring_sides(): no try came out clean and none was less tangled
     /// than the input, which is the result, unchanged (moved_vertices 0; the counts after are
@@ -243,9 +244,10 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// result keeps the clean one that moves a vertex least (report.inferred_sides, `kept` those
 /// sides). When every try fails, they all run once more with params.long_rounds_factor times the
 /// gradient steps (report.long_rounds; where the inferred sides have rolled regions, those sides
-/// alone); when those fail too, all of that once more with params.retry_passes_factor times the
-/// passes (report.retry_passes); when that fails too and nothing is read rolled, the global
-/// order's second try with params.more_passes_factor times the passes (report.more_passes). With
+/// alone); when those fail too and nothing is read rolled, the global order's second try with
+/// params.more_passes_factor times the passes (report.more_passes); when that fails too, all of
+/// the tries and long rounds once more with params.retry_passes_factor times the passes
+/// (report.retry_passes). With
 /// params.input_sides given (an original's sides, not in question), untangle(), when it fails
 /// once more with the long rounds, and when those fail all of that with
 /// params.retry_passes_factor times the passes; all of that first without the sides read at a
