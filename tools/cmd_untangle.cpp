@@ -204,6 +204,10 @@ Run add_untangle_command(CLI::App& app) {
                     std::to_string(r.sides_reading) + ", the clean one that moved least)";
             else if (r.inferred_sides)
                 why = " (the input has rolled regions)";
+            else if (r.sides_left_out > 0)
+                why = "; " + std::to_string(r.sides_left_out) +
+                      " vertex sides read at the other sheet of a fold the decimation closed "
+                      "left out (only the distance counts there)";
             std::printf(
                 "sides %s %s: %zu vertices on a rolled side (the other side of an open layer "
                 "than the global order), %zu kept it%s\n",
