@@ -375,12 +375,10 @@ UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, All
     UntangleParams more = params;
     more.max_passes = static_cast<int>(std::min<double>(passes, std::numeric_limits<int>::max()));
     Scene attempt = input;
-    failures.long_rounds = false;
-    failures.more_passes = false;
+    failures.long_rounds = false;  // with_long_rounds() set it for its own retry
     failures.retry_passes = true;
     UntangleReport second = all_tries(attempt, more);
     second.retry_passes = true;
-    failures.long_rounds = false;
     return after_retry(scene, report, std::move(attempt), second);
 }
 

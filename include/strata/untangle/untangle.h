@@ -108,9 +108,7 @@ struct UntangleParams {
     /// failed, long rounds included (before retry_passes_factor's retry), the global order's
     /// second try (no self-crossing made) runs once more from the input with max_passes x this
     /// factor (the projection of a fold cut by chords wanders for a while before it comes out
-    /// clean).
-    /// <= 1: no such retry.
-    /// docs/untangle.md, "More passes when every try fails".
+    /// clean). <= 1: no such retry. docs/untangle.md, "More passes when every try fails".
     int more_passes_factor = 4;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
@@ -247,18 +245,17 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// alone); when those fail too and nothing is read rolled, the global order's second try with
 /// params.more_passes_factor times the passes (report.more_passes); when that fails too, all of
 /// the tries and long rounds once more with params.retry_passes_factor times the passes
-/// (report.retry_passes). With
-/// params.input_sides given (an original's sides, not in question), untangle(), when it fails
-/// once more with the long rounds, and when those fail all of that with
-/// params.retry_passes_factor times the passes; all of that first without the sides read at a
-/// fold's other sheet (InputSides::off_other_sheets(); report.sides_left_out, `kept` those
-/// sides), then, when some were left out and that is not clean, with every side. When every
-/// try fails, the result is the least
-/// tangled of all their results and the input, as untangle() orders them, each try judged by the
-/// sides it untangled toward (report.inferred_sides and sides_reading say which). Same params,
-/// progress and throws as untangle(). `kept`: if given, receives the inferred sides when they were
-/// kept (a clean result's, or a failed one's), for judging the result (check_scene() with them and
-/// params' outside sides, or outside_sides() of the input); left alone otherwise.
+/// (report.retry_passes). With params.input_sides given (an original's sides, not in question),
+/// untangle(), when it fails once more with the long rounds, and when those fail all of that
+/// with params.retry_passes_factor times the passes; all of that first without the sides read
+/// at a fold's other sheet (InputSides::off_other_sheets(); report.sides_left_out, `kept` those
+/// sides), then, when some were left out and that is not clean, with every side. When every try
+/// fails, the result is the least tangled of all their results and the input, as untangle()
+/// orders them, each try judged by the sides it untangled toward (report.inferred_sides and
+/// sides_reading say which). Same params, progress and throws as untangle(). `kept`: if given,
+/// receives the inferred sides when they were kept (a clean result's, or a failed one's), for
+/// judging the result (check_scene() with them and params' outside sides, or outside_sides() of
+/// the input); left alone otherwise.
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params = {},
                                         const ProgressFn& progress = {},
                                         InputSides* kept = nullptr);
