@@ -3,7 +3,8 @@
 # benchmark's: the 12 generated families of strata_bench_untangle at 300 points a layer (POINTS),
 # decimated naively at random (90% and 95%) with each seed, untangled with `strata untangle`
 # (sides inferred, no original), then judged by `strata check --reference ORIGINAL`: clean
-# means no crossing, the gaps kept and every vertex on the original's side of its neighbours.
+# means no crossing, every vertex on the original's side of its neighbours (the check's exit
+# code) and the gaps kept: the smallest gap / required >= 0.9 x min(1, the original's).
 #
 #   bench/out_of_sample.sh BUILD WORK [SEEDS...]        default seeds 2 3 4 5 6
 #   REFERENCE=1 bench/out_of_sample.sh BUILD WORK ...   untangle with --reference ORIGINAL too
@@ -59,12 +60,26 @@ hu, ht = far(sys.argv[1]), far(sys.argv[2])
 if hu > 2 * ht:
     print(hu, ht)' "$1" "$2"
 }
+# The smallest gap / required of the check report $1 (`strata check --json`).
+gap_ratio() {
+    python3 -c '
+import json, sys
+with open(sys.argv[1]) as f:
+    print(json.load(f)["min_separation_ratio"])' "$1"
+}
+# Exit 0 when the gap ratio $1 of an untangled scene keeps 0.9 x min(1, $2), the original's.
+gaps_kept() {
+    python3 -c 'import sys; u, o = map(float, sys.argv[1:]); sys.exit(u < 0.9 * min(1.0, o))' \
+        "$1" "$2"
+}
 clean=0
 distorted=0
 total=0
 start=$(date +%s.%N)
 for f in $families; do
     original=$work/inputs/$f-naive90.input.json
+    "$strata" check "$original" --json >"$work/inputs/$f.check" 2>/dev/null || true
+    original_gap=$(gap_ratio "$work/inputs/$f.check")
     for r in 0.9 0.95; do
         for s in "${seeds[@]}"; do
             t=$work/out/$f-$r-$s.tangled.json
@@ -78,6 +93,9 @@ for f in $families; do
             ce=0
             "$strata" check "$u" --reference "$original" --json >"$u.check" 2>/dev/null || ce=$?
             total=$((total + 1))
+            if [ $ce = 0 ] && ! gaps_kept "$(gap_ratio "$u.check")" "$original_gap"; then
+                ce=gap
+            fi
             if [ $ce = 0 ]; then
                 clean=$((clean + 1))
                 # (check exits 1 on the tangled scene, which crosses: its report is whole.)
@@ -90,7 +108,9 @@ for f in $families; do
                     echo "distorted: $f $r seed $s (Hausdorff to the original $hu, tangled $ht)"
                 fi
             else
-                echo "dirty: $f $r seed $s (untangle exit $ue)"
+                gap=""
+                [ $ce = gap ] && gap=", gaps short: $(gap_ratio "$u.check") x required"
+                echo "dirty: $f $r seed $s (untangle exit $ue$gap)"
             fi
         done
     done
