@@ -28,8 +28,9 @@
 // "real"): slices of real garments (../shared/data/garments, bench/garments.sh) where the
 // meshes interpenetrate. "--slices none" leaves them out.
 // --sides: the un-decimated input is the reference, as `strata untangle --reference` has it:
-// its sides of the open layers are given to untangle() (UntangleParams::input_sides,
-// outside_sides). Real slices are untangled as without it (their input is the tangle).
+// its sides of the open layers are given to untangle_inferring_sides()
+// (UntangleParams::input_sides, outside_sides; first without the sides read at a fold's other
+// sheet). Real slices are untangled as without it (their input is the tangle).
 // --global-order: untangle() by the global order alone (`strata untangle --global-order`).
 // --gap G: FamilyParams::gap (segment lengths, default 2) of every family's scene (not the
 // stack's fixed wider and narrower cases), e.g. to sweep `strata simplify` over gaps.
@@ -195,8 +196,8 @@ Row run(const std::string& name, const std::string& how, const Scene& input,
         const ProgressFn capped = [&](std::string_view, double) {
             return now() - start < cap_seconds;
         };
-        report = keep_sides || global_order ? untangle(scene, p, capped)
-                                            : untangle_inferring_sides(scene, p, capped, &inferred);
+        report = global_order ? untangle(scene, p, capped)
+                              : untangle_inferring_sides(scene, p, capped, &inferred);
     } catch (const Cancelled&) {
         row.capped = true;
         scene = tangled;
