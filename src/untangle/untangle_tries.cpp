@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -236,9 +237,10 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     with_sides.input_sides = &inferred;
     with_sides.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
     const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
-    // By the inferred sides, then by the global order; the second tries (no self-crossing
-    // made) only when neither first try is clean, so that a scene one of them cleans costs
-    // what it did without them.
+    // Where the input has rolled regions: by the inferred sides, first try then second (no
+    // self-crossing made), before the global order, which unrolls them. Elsewhere by the global
+    // order, then by the inferred sides (see below), the second tries only when neither first
+    // try is clean, so that a scene one of them cleans costs what it did without them.
     const Scene input = scene;
     TriesCost cost;
     // One try from the input into `attempt`; true when it comes out clean. `sides`, `reading`:
@@ -250,38 +252,37 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
         cost.add(report);
         return report.collision_free;
     };
+    // The first clean try of `order` (by the inferred sides or by the global order), the
+    // first tries of the order before its second ones: `scene` becomes its result, and the
+    // report counts every try so far; nullopt when none is clean.
+    auto first_clean = [&](std::initializer_list<bool> order) -> std::optional<UntangleReport> {
+        for (bool keep_simple : {false, true})
+            for (bool by_inferred : order) {
+                Scene attempt;
+                UntangleReport report;
+                const bool clean =
+                    by_inferred ? clean_try(with_sides, keep_simple, attempt, report, &inferred, 0)
+                                : clean_try(global, keep_simple, attempt, report, nullptr, 0);
+                if (!clean) continue;
+                report.inferred_sides = by_inferred;
+                if (by_inferred && kept) *kept = std::move(inferred);
+                scene = std::move(attempt);
+                return cost.charged_to(report);
+            }
+        return std::nullopt;
+    };
     if (inferred_only) {
-        UntangleReport report;
-        if (!rolled) return report;
-        for (bool keep_simple : {false, true}) {
-            Scene attempt;
-            if (!clean_try(with_sides, keep_simple, attempt, report, &inferred, 0)) continue;
-            report.inferred_sides = true;
-            if (kept) *kept = std::move(inferred);
-            scene = std::move(attempt);
-            return cost.charged_to(report);
-        }
-        return cost.charged_to(report);
+        if (!rolled) return UntangleReport{};  // failed
+        return first_clean({true}).value_or(cost.charged_to(UntangleReport{}));
     }
-    for (bool keep_simple : {false, true}) {
-        Scene attempt;
-        UntangleReport report;
-        if (rolled && clean_try(with_sides, keep_simple, attempt, report, &inferred, 0)) {
-            report.inferred_sides = true;
-            if (kept) *kept = std::move(inferred);
-        } else if (!clean_try(global, keep_simple, attempt, report, nullptr, 0)) {
-            // Without rolled regions the inferred sides are the global order's, but for the
-            // vertices they give no side (around an end of the other layer, a tie): there only
-            // the distance counts. A fold cut by the decimation (the folded scenes) can come
-            // out clean so where the global order, pushing those vertices too, does not.
-            if (rolled || !clean_try(with_sides, keep_simple, attempt, report, &inferred, 0))
-                continue;
-            report.inferred_sides = true;
-            if (kept) *kept = std::move(inferred);
-        }
-        scene = std::move(attempt);
-        return cost.charged_to(report);
-    }
+    // Without rolled regions the inferred sides are the global order's, but for the vertices
+    // they give no side (around an end of the other layer, a tie): there only the distance
+    // counts. A fold cut by the decimation (the folded scenes) can come out clean so where the
+    // global order, pushing those vertices too, does not.
+    std::optional<UntangleReport> done;
+    if (rolled && !(done = first_clean({true}))) done = first_clean({false});
+    if (!rolled) done = first_clean({false, true});
+    if (done) return *done;
     // Neither is clean: the other readings of the regions whose recorded sides disagree
     // (InputSides::region_alternatives(), at most params.other_readings of them, best fitting
     // first), each tried once, then once more without self-crossings made (as above); of the

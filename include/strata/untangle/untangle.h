@@ -231,11 +231,12 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// where the input has regions on the other side of an open layer than the global order says
 /// (a part rolled or folded over an open layer, which the global order pushes back), by the
 /// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
-/// rolled; that result is kept when it is clean against those sides (report.inferred_sides).
-/// Otherwise, or when it is not clean, by the global order (untangle() from the input); where
-/// nothing is read rolled and the global order's try is not clean, by the inferred sides, which
-/// are then the global order's but give no side to the vertices around another layer's end
-/// (there only the distance counts), each first try before the second. When neither is clean, by
+/// rolled, both of untangle()'s tries (the second when the first is not clean); a result is kept
+/// when it is clean against those sides (report.inferred_sides). Otherwise, or when neither is
+/// clean, by the global order (untangle() from the input); where nothing is read rolled and the
+/// global order's try is not clean, by the inferred sides, which are then the global order's but
+/// give no side to the vertices around another layer's end (there only the distance counts),
+/// each first try before the second. When neither is clean, by
 /// each of the first 4 other readings of the inferred regions (InputSides::region_alternatives() of
 /// the input's recorded sides: a region whose vertices' sides disagree, split in two or given the
 /// other side), first as untangle()'s first try, then as its second; the first round with a clean
