@@ -160,6 +160,14 @@ int saturated_product(int a, int b) {
     return static_cast<int>(std::min<long long>(product, std::numeric_limits<int>::max()));
 }
 
+// `params` with long_rounds_factor times the gradient steps, and no more long rounds.
+UntangleParams longer_rounds(const UntangleParams& params) {
+    UntangleParams longer = params;
+    longer.gradient_steps = saturated_product(params.gradient_steps, params.long_rounds_factor);
+    longer.long_rounds_factor = 1;
+    return longer;
+}
+
 // After a failed try (`failed`), another one from the input (`second`, its result in
 // `attempt`): the second result is kept when clean; otherwise the report is a failed one
 // (which result is kept, LeastTangled says). The report counts both.
@@ -185,27 +193,21 @@ bool has_rolled_regions(const Scene& scene) {
 }
 
 // When the tries with params fail, they run again with long rounds (UntangleParams::
-// long_rounds_factor) and the first clean result is kept; the report counts both. Where the
-// sides are in question (`in_question()`: not an original's, and the scene has rolled regions;
-// asked only when the tries failed), the retry takes the inferred sides alone
-// (`tries(scene, params, true)`), which keep the rolled regions: with the global order and the
-// other readings, longer rounds let a wrong reading hold (the collar at 95%, seeds 4 and 9,
-// came out clean by the global order with its fold unrolled), and the untangling had better
-// say it failed.
-template <class Tries, class InQuestion>
-UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params,
-                                InQuestion&& in_question_of, Tries&& tries,
-                                LeastTangled& failures) {
+// long_rounds_factor) and the first clean result is kept; the report counts both. Not where
+// `ran_long(input)` (asked only when the tries failed): where rolled regions are read, the
+// tries already ran the inferred sides with long rounds, before the global order
+// (inferring_sides_tries()), and long rounds of the global order and the other readings let a
+// wrong reading hold (the collar at 95%, seeds 4 and 9, came out clean by the global order
+// with its fold unrolled): the untangling had better say it failed.
+template <class Tries, class RanLong>
+UntangleReport with_long_rounds(Scene& scene, const UntangleParams& params, RanLong&& ran_long,
+                                Tries&& tries, LeastTangled& failures) {
     const Scene input = scene;
-    UntangleReport report = tries(scene, params, false);
-    if (report.collision_free || params.long_rounds_factor <= 1) return report;
-    const bool in_question = in_question_of(input);
-    UntangleParams longer = params;
-    longer.gradient_steps = saturated_product(params.gradient_steps, params.long_rounds_factor);
-    longer.long_rounds_factor = 1;
+    UntangleReport report = tries(scene, params);
+    if (report.collision_free || params.long_rounds_factor <= 1 || ran_long(input)) return report;
     Scene attempt = input;
     failures.long_rounds = true;
-    UntangleReport second = tries(attempt, longer, in_question);
+    UntangleReport second = tries(attempt, longer_rounds(params));
     second.long_rounds = true;
     return after_retry(scene, report, std::move(attempt), second);
 }
@@ -223,11 +225,9 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given, const P
     return after_retry(scene, report, std::move(simple), second);
 }
 
-// `inferred_only`: the tries by the inferred sides alone, when they have rolled regions (a
-// failed report otherwise); no global order, no other reading.
 UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
                                      const ProgressFn& progress, InputSides* kept,
-                                     bool inferred_only, LeastTangled& failures) {
+                                     LeastTangled& failures) {
     // Regions of the input on the other side of an open layer than the global order says (a
     // roll, which the global order pushes back): kept there, when that comes out clean.
     const InputSides recorded = record_input_sides(scene);
@@ -238,9 +238,10 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     with_sides.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
     const bool rolled = inferred.rolled_count(scene, with_sides.outside_sides) > 0;
     // Where the input has rolled regions: by the inferred sides, first try then second (no
-    // self-crossing made), before the global order, which unrolls them. Elsewhere by the global
-    // order, then by the inferred sides (see below), the second tries only when neither first
-    // try is clean, so that a scene one of them cleans costs what it did without them.
+    // self-crossing made), then both again with long rounds, before the global order, which
+    // unrolls them. Elsewhere by the global order, then by the inferred sides (see below), the
+    // second tries only when neither first try is clean, so that a scene one of them cleans
+    // costs what it did without them.
     const Scene input = scene;
     TriesCost cost;
     // One try from the input into `attempt`; true when it comes out clean. `sides`, `reading`:
@@ -255,13 +256,15 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     // The first clean try of `order` (by the inferred sides or by the global order), the
     // first tries of the order before its second ones: `scene` becomes its result, and the
     // report counts every try so far; nullopt when none is clean.
-    auto first_clean = [&](std::initializer_list<bool> order) -> std::optional<UntangleReport> {
+    // `by_sides`: the params of the tries by the inferred sides.
+    auto first_clean = [&](std::initializer_list<bool> order,
+                           const UntangleParams& by_sides) -> std::optional<UntangleReport> {
         for (bool keep_simple : {false, true})
             for (bool by_inferred : order) {
                 Scene attempt;
                 UntangleReport report;
                 const bool clean =
-                    by_inferred ? clean_try(with_sides, keep_simple, attempt, report, &inferred, 0)
+                    by_inferred ? clean_try(by_sides, keep_simple, attempt, report, &inferred, 0)
                                 : clean_try(global, keep_simple, attempt, report, nullptr, 0);
                 if (!clean) continue;
                 report.inferred_sides = by_inferred;
@@ -271,17 +274,23 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
             }
         return std::nullopt;
     };
-    if (inferred_only) {
-        if (!rolled) return UntangleReport{};  // failed
-        return first_clean({true}).value_or(cost.charged_to(UntangleReport{}));
-    }
     // Without rolled regions the inferred sides are the global order's, but for the vertices
     // they give no side (around an end of the other layer, a tie): there only the distance
     // counts. A fold cut by the decimation (the folded scenes) can come out clean so where the
     // global order, pushing those vertices too, does not.
     std::optional<UntangleReport> done;
-    if (rolled && !(done = first_clean({true}))) done = first_clean({false});
-    if (!rolled) done = first_clean({false, true});
+    if (rolled) {
+        done = first_clean({true}, with_sides);
+        if (!done && with_sides.long_rounds_factor > 1) {
+            failures.long_rounds = true;
+            done = first_clean({true}, longer_rounds(with_sides));
+            failures.long_rounds = false;
+            if (done) done->long_rounds = true;
+        }
+        if (!done) done = first_clean({false}, with_sides);
+    } else {
+        done = first_clean({false, true}, with_sides);
+    }
     if (done) return *done;
     // Neither is clean: the other readings of the regions whose recorded sides disagree
     // (InputSides::region_alternatives(), at most params.other_readings of them, best fitting
@@ -407,8 +416,8 @@ UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
             s, p,
             [&](Scene& t, const UntangleParams& q) {
                 return with_long_rounds(
-                    t, q, [](const Scene&) { return false; },  // the original's: not in question
-                    [&](Scene& u, const UntangleParams& r, bool /*in_question*/) {
+                    t, q, [](const Scene&) { return false; },
+                    [&](Scene& u, const UntangleParams& r) {
                         return untangle_tries(u, r, progress, f);
                     },
                     f);
@@ -469,8 +478,8 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
         [&](Scene& s, const UntangleParams& p) {
             return with_long_rounds(
                 s, p, rolled_regions,
-                [&](Scene& t, const UntangleParams& q, bool in_question) {
-                    return inferring_sides_tries(t, q, progress, kept, in_question, failures);
+                [&](Scene& t, const UntangleParams& q) {
+                    return inferring_sides_tries(t, q, progress, kept, failures);
                 },
                 failures);
         },

@@ -90,8 +90,9 @@ struct UntangleParams {
     /// longer, so shape matching, which pulls toward the tangled input, comes this many times
     /// less often per projection step); the first clean result of those is kept. <= 1: no such
     /// retry. A scene that an earlier try cleans never gets here (its output is unchanged). A
-    /// scene with rolled regions by its inferred sides retries by those sides alone, which keep
-    /// the rolls (where the sides are in question, longer rounds by the global order or another
+    /// scene with rolled regions by its inferred sides instead runs the tries by those sides
+    /// with long rounds when their first two fail, before the global order's, and not after
+    /// every try (where the sides are in question, longer rounds by the global order or another
     /// reading let a wrong reading hold). untangle() itself does not retry. docs/untangle.md,
     /// "Longer rounds when every try fails".
     int long_rounds_factor = 3;
@@ -191,8 +192,9 @@ struct UntangleReport {
     /// untangle(): the first try did not come out clean, and the result is the second, from
     /// the input, in which no vertex move makes a self-crossing.
     bool kept_simple = false;
-    /// untangle_inferring_sides(): every try with params.gradient_steps failed, and the result
-    /// is that of the retry with params.long_rounds_factor times as many.
+    /// untangle_inferring_sides(): the tries with params.gradient_steps failed (where rolled
+    /// regions are read, those by the inferred sides), and the result is that of the tries with
+    /// params.long_rounds_factor times as many.
     bool long_rounds = false;
     /// untangle_inferring_sides(): every try failed, long rounds and the more_passes retry
     /// included, and the result is that of their retry with params.retry_passes_factor times
@@ -231,8 +233,9 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// where the input has regions on the other side of an open layer than the global order says
 /// (a part rolled or folded over an open layer, which the global order pushes back), by the
 /// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
-/// rolled, both of untangle()'s tries (the second when the first is not clean); a result is kept
-/// when it is clean against those sides (report.inferred_sides). Otherwise, or when neither is
+/// rolled, both of untangle()'s tries (the second when the first is not clean), then both with
+/// params.long_rounds_factor times the gradient steps (report.long_rounds); a result is kept
+/// when it is clean against those sides (report.inferred_sides). Otherwise, or when none is
 /// clean, by the global order (untangle() from the input); where nothing is read rolled and the
 /// global order's try is not clean, by the inferred sides, which are then the global order's but
 /// give no side to the vertices around another layer's end (there only the distance counts),
@@ -241,9 +244,9 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// the input's recorded sides: a region whose vertices' sides disagree, split in two or given the
 /// other side), first as untangle()'s first try, then as its second; the first round with a clean
 /// result keeps the clean one that moves a vertex least (report.inferred_sides, `kept` those
-/// sides). When every try fails, they all run once more with params.long_rounds_factor times the
-/// gradient steps (report.long_rounds; where the inferred sides have rolled regions, those sides
-/// alone); when those fail too and nothing is read rolled, the global order's second try with
+/// sides). When every try fails and nothing is read rolled, they all run once more with
+/// params.long_rounds_factor times the gradient steps (report.long_rounds); when those fail too
+/// (and nothing is read rolled), the global order's second try with
 /// params.more_passes_factor times the passes (report.more_passes); when that fails too, all of
 /// the tries and long rounds once more with params.retry_passes_factor times the passes
 /// (report.retry_passes). With params.input_sides given (an original's sides, not in question),
