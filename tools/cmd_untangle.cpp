@@ -174,6 +174,9 @@ Run add_untangle_command(CLI::App& app) {
                 {"long_rounds", r.long_rounds},
                 {"retry_passes", r.retry_passes},
                 {"more_passes", r.more_passes},
+                {"loop_reading", r.loop_reading},
+                {"untwisted", r.untwisted},
+                {"restarted", r.restarted},
                 {"input_kept", r.input_kept},
                 {"gave_up", r.gave_up}};
             if (params.input_sides)

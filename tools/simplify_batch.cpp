@@ -206,12 +206,15 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
     Scene scene;
     CheckReport after;
     for (std::size_t i = 0; i < starts.size(); ++i) {
-        // The other readings of the input's regions (a last resort, up to 8 more tries) and
-        // the retry with more passes only on the last start: the gapped one fails fast where
-        // the gaps ask for more room.
+        // The other readings of the input's regions (a last resort, up to 8 more tries), the
+        // retry with more passes and the last resorts only on the last start: the gapped one
+        // fails fast where the gaps ask for more room.
         const bool last = i + 1 == starts.size();
         u.other_readings = last ? defaults.other_readings : 0;
         u.retry_passes_factor = last ? defaults.retry_passes_factor : 1.0;
+        u.loop_readings = last && defaults.loop_readings;
+        u.untwist = last && defaults.untwist;
+        u.restart = last && defaults.restart;
         scene = untangle_input(starts[i], u, info, after);
         if (after.is_collision_free()) break;
     }

@@ -662,6 +662,46 @@ std::size_t InputSides::vertex_count(std::size_t a) const {
     return r == kNoLayer ? 0 : recorded_->scene.layer(r).points.size();
 }
 
+std::vector<InputSides> InputSides::loop_readings(const Scene& scene) const {
+    if (empty()) return {};
+    if (scene.size() != n_)
+        throw InvalidInput("input sides: loop_readings() got " + std::to_string(scene.size()) +
+                           " layers for " + std::to_string(n_));
+    std::vector<std::vector<signed char>> codes(n_ * n_);
+    for (std::size_t a = 0; a < n_; ++a)
+        for (std::size_t b = 0; b < n_; ++b) {
+            if (a == b) continue;
+            std::vector<signed char>& out = codes[a * n_ + b];
+            for (std::size_t k = 0; k < scene.layer(a).points.size(); ++k) {
+                const int c = code(a, k, b);
+                if (c == 0 && out.empty()) continue;
+                out.resize(scene.layer(a).points.size(), 0);
+                out[k] = static_cast<signed char>(c);
+            }
+        }
+    std::vector<InputSides> readings;
+    for (std::size_t a = 0; a < n_; ++a)
+        for (std::size_t b = 0; b < n_; ++b) {
+            const Layer& loop = scene.layer(a);
+            const Layer& other = scene.layer(b);
+            if (a == b || !loop.closed || other.closed || other.points.size() < 2 ||
+                diagonal(loop) > 0.5 * diagonal(other))
+                continue;
+            const std::vector<signed char>& s = codes[a * n_ + b];
+            const auto plus = std::count(s.begin(), s.end(), static_cast<signed char>(1));
+            const auto minus = std::count(s.begin(), s.end(), static_cast<signed char>(-1));
+            if (plus == 0 || minus == 0) continue;
+            const signed char first = plus >= minus ? 1 : -1;
+            for (const signed char side : {first, static_cast<signed char>(-first)}) {
+                std::vector<std::vector<signed char>> changed = codes;
+                for (signed char& c : changed[a * n_ + b])
+                    if (c == 1 || c == -1) c = side;
+                readings.push_back(from_codes(scene, std::move(changed)));
+            }
+        }
+    return readings;
+}
+
 InputSides InputSides::off_other_sheets(const Scene& scene) const {
     if (empty()) return {};
     if (scene.size() != n_)

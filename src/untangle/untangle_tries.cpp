@@ -3,8 +3,12 @@
 // more passes, each one an untangling of the whole scene by detail::run_untangling().
 #include "strata/untangle/untangle.h"
 
+#include "strata/geometry/checks.h"
 #include "strata/geometry/input_sides.h"
+#include "strata/geometry/predicates.h"
 #include "untangle/detail/run.h"
+
+#include <glm/geometric.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -70,7 +74,7 @@ struct TriesCost {
 class LeastTangled {
   public:
     /// Stamped on the reports offered from now on (the retries' flags).
-    bool long_rounds = false, retry_passes = false, more_passes = false;
+    bool long_rounds = false, retry_passes = false, more_passes = false, loop_reading = false;
 
     // The result of a failed try (`scene`, `report`); `sides`: the inferred sides it kept
     // (report.inferred_sides), or nullptr for params' own.
@@ -80,6 +84,7 @@ class LeastTangled {
         report.long_rounds = long_rounds;
         report.retry_passes = retry_passes;
         report.more_passes = more_passes;
+        report.loop_reading = loop_reading;
         report.inferred_sides = sides != nullptr;
         report.sides_reading = reading;
         if (!sides && !input_) input_ = as_input(report);
@@ -93,15 +98,19 @@ class LeastTangled {
     // `failed` (a failed report with the cost of every try, from `input`): `scene` becomes the
     // least tangled result, the input included, and the report is its, with that cost;
     // `kept`, if given, receives the sides it kept when inferred.
+    // `tried`, if given, receives the inferred sides the result kept was tried with (reset
+    // when it was tried with params' own, or is the input).
     UntangleReport keep(Scene& scene, const Scene& input, const UntangleReport& failed,
-                        InputSides* kept) {
+                        InputSides* kept, std::optional<InputSides>* tried = nullptr) {
         UntangleReport report = failed;
+        if (tried) tried->reset();
         if (input_ && (!scene_ || less_tangled(*input_, report_))) {
             report = *input_;
             scene = input;
         } else if (scene_) {
             report = report_;
             scene = std::move(*scene_);
+            if (tried && sides_) *tried = *sides_;
             if (kept && sides_) *kept = std::move(*sides_);
         }
         scene_.reset();
@@ -330,6 +339,168 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
 }  // namespace
 namespace {
 
+// Segments of `scene` that the segments at vertex v of layer l meet with that vertex at `at`:
+// {of other layers, of layer l}. The segments next to those two are left out (they share an
+// end with them).
+std::pair<std::size_t, std::size_t> segments_met(const Scene& scene, std::size_t l, std::size_t v,
+                                                 const Vec2& at) {
+    const Layer& layer = scene.layer(l);
+    const std::size_t n = layer.points.size();
+    const bool closed = layer.closed;
+    std::vector<std::pair<Vec2, Vec2>> own;
+    if (v > 0 || closed) own.emplace_back(layer.points[(v + n - 1) % n], at);
+    if (v + 1 < n || closed) own.emplace_back(at, layer.points[(v + 1) % n]);
+    // Segment j of layer l shares an end with a segment at v.
+    auto next_to_v = [&](std::size_t j) {
+        if (!closed) return j + 2 >= v && j <= v + 1;
+        for (const std::size_t d : {n - 2, n - 1, std::size_t{0}, std::size_t{1}})
+            if (j == (v + d) % n) return true;
+        return false;
+    };
+    std::size_t others = 0, self = 0;
+    for (std::size_t m = 0; m < scene.size(); ++m) {
+        const std::vector<Vec2>& q = scene.layer(m).points;
+        const std::size_t segments =
+            q.size() < 2 ? 0 : (scene.layer(m).closed ? q.size() : q.size() - 1);
+        for (std::size_t j = 0; j < segments; ++j) {
+            if (m == l && next_to_v(j)) continue;
+            for (const auto& [p0, p1] : own)
+                if (segment_contact(p0, p1, q[j], q[(j + 1) % q.size()]) != SegmentContact::None)
+                    ++(m == l ? self : others);
+        }
+    }
+    return {others, self};
+}
+
+// The report of a clean try `report` (result `result`) that started from the least tangled
+// result of a call (`failed`, its report, from `input`): failed's counts before and flags, the
+// try's counts after, the displacement from `input`.
+UntangleReport as_kept(const UntangleReport& failed, const UntangleReport& report,
+                       const Scene& result, const Scene& input) {
+    UntangleReport kept = failed;
+    kept.collision_free = report.collision_free;
+    kept.converged = report.converged;
+    kept.gave_up = report.gave_up;
+    kept.mean_speed = report.mean_speed;
+    kept.crossings_after = report.crossings_after;
+    kept.self_crossings_after = report.self_crossings_after;
+    kept.nesting_violations_after = report.nesting_violations_after;
+    kept.min_separation_ratio_after = report.min_separation_ratio_after;
+    kept.rolled_kept = report.rolled_kept;
+    kept.input_kept = false;
+    kept.max_displacement = 0.0;
+    kept.moved_vertices = 0;
+    const double diagonal = glm::length(input.bounds().size());
+    for (std::size_t l = 0; l < result.size(); ++l)
+        for (std::size_t v = 0; v < result.layer(l).points.size(); ++v) {
+            const double d = glm::distance(result.layer(l).points[v], input.layer(l).points[v]);
+            kept.max_displacement = std::max(kept.max_displacement, d);
+            if (d > 1e-12 * diagonal) ++kept.moved_vertices;
+        }
+    return kept;
+}
+
+// Takes the self-crossings out of `scene` one vertex move at a time: for each self-crossing
+// of segments s and t of a layer, each end vertex of either may move straight across the
+// other's line to its far side, the layer's thickness beyond it; of the moves that leave the
+// vertex's two segments meeting fewer segments of their layer and no more of other layers
+// (exact), the shortest is made. Nothing else takes a self-crossing out (the projection and
+// the finishing stage do not; docs/untangle.md). False when some are left (no such move).
+bool untwist(Scene& scene) {
+    const Box2 box = scene.bounds();
+    const double floor = 1e-9 * glm::length(box.size());
+    CheckParams params;
+    params.max_listed = 1;
+    CheckReport check = check_scene(scene, params);
+    const std::size_t limit = 4 * check.total_self_crossings() + 4;
+    for (std::size_t step = 0; step < limit; ++step) {
+        if (check.total_self_crossings() == 0) return true;
+        params.max_listed = check.total_self_crossings();
+        check = check_scene(scene, params);
+        double shortest = std::numeric_limits<double>::infinity();
+        std::size_t best_layer = 0, best_vertex = 0;
+        Vec2 best_at(0.0);
+        for (const Crossing& c : check.self_crossings) {
+            const Layer& layer = scene.layer(c.layer_a);
+            const std::size_t n = layer.points.size();
+            const double aim = std::max(layer.thickness, floor);
+            for (const auto& [mine, theirs] :
+                 {std::pair{c.segment_a, c.segment_b}, std::pair{c.segment_b, c.segment_a}}) {
+                const Vec2 q0 = layer.points[theirs], q1 = layer.points[(theirs + 1) % n];
+                const double length = glm::length(q1 - q0);
+                if (!(length > 0.0)) continue;
+                const Vec2 normal = Vec2(q0.y - q1.y, q1.x - q0.x) / length;
+                for (const std::size_t v : {mine, (mine + 1) % n}) {
+                    const Vec2 p = layer.points[v];
+                    const double d = glm::dot(p - q0, normal);
+                    if (d == 0.0) continue;
+                    const double move = std::abs(d) + aim;
+                    if (!(move < shortest)) continue;
+                    const Vec2 at = p - (d + (d > 0.0 ? aim : -aim)) * normal;
+                    const auto before = segments_met(scene, c.layer_a, v, p);
+                    const auto after = segments_met(scene, c.layer_a, v, at);
+                    if (after.second >= before.second || after.first > before.first) continue;
+                    shortest = move;
+                    best_layer = c.layer_a;
+                    best_vertex = v;
+                    best_at = at;
+                }
+            }
+        }
+        if (!std::isfinite(shortest)) return false;
+        std::vector<Vec2> points = scene.layer(best_layer).points;
+        points[best_vertex] = best_at;
+        scene.set_points(best_layer, std::move(points));
+        params.max_listed = 1;
+        check = check_scene(scene, params);
+    }
+    return check.total_self_crossings() == 0;
+}
+
+// The least tangled result `scene` of untangle_inferring_sides() when every try failed
+// (`failed`, its report, from `input`), self-crossings left: untwist() them, then one more
+// try from there (no self-crossing made) by the sides that result was tried with (`p`); kept
+// when clean (report.untwisted), with the counts before and the displacement from `input`.
+// The report counts every try.
+UntangleReport untwisted_try(Scene& scene, const Scene& input, const UntangleParams& p,
+                             const UntangleReport& failed, const ProgressFn& progress) {
+    Scene attempt = scene;
+    if (!untwist(attempt)) return failed;
+    UntangleReport report =
+        detail::run_untangling(attempt, whole_scene_pieces(attempt), p, progress, true);
+    TriesCost cost;
+    cost.add(failed);
+    cost.add(report);
+    if (!report.collision_free) return cost.charged_to(failed);
+    UntangleReport kept = as_kept(failed, report, attempt, input);
+    kept.untwisted = true;
+    scene = std::move(attempt);
+    return cost.charged_to(kept);
+}
+
+UntangleReport given_sides_tries(Scene& scene, const UntangleParams& params,
+                                 const ProgressFn& progress, LeastTangled& failures);
+
+// The least tangled result `scene` of untangle_inferring_sides() when every try failed
+// (`failed`, its report, from `input`), after untwisted_try() if it ran: untangle()'s tries,
+// long rounds and the retry with more passes once more, from that result, by the sides it was
+// tried with (`p`); kept when clean (report.restarted), with the counts before and the
+// displacement from `input`. The report counts every try.
+UntangleReport restarted_tries(Scene& scene, const Scene& input, const UntangleParams& p,
+                               const UntangleReport& failed, const ProgressFn& progress) {
+    Scene attempt = scene;
+    LeastTangled not_kept;  // a failed restart keeps the result it started from
+    const UntangleReport report = given_sides_tries(attempt, p, progress, not_kept);
+    TriesCost cost;
+    cost.add(failed);
+    cost.add(report);
+    if (!report.collision_free) return cost.charged_to(failed);
+    UntangleReport kept = as_kept(failed, report, attempt, input);
+    kept.restarted = true;
+    scene = std::move(attempt);
+    return cost.charged_to(kept);
+}
+
 // `progress` with the tries told apart: every try counts its rounds from 0 again, so a fraction
 // that does not grow starts another try, whose stage is "untangle, try N" (N from 2; a progress
 // bar that starts again says why). Empty when `progress` is.
@@ -353,14 +524,16 @@ ProgressFn numbering_tries(const ProgressFn& progress) {
 // `tries(failures)` on `scene` (they offer their failed results to `failures`): when none
 // comes out clean, the least tangled result, the input included (LeastTangled), with its
 // report; `kept` as untangle_inferring_sides(). `scene` is unchanged on throw.
+// `tried`: LeastTangled::keep()'s.
 template <class Tries>
-UntangleReport clean_or_least_tangled(Scene& scene, InputSides* kept, Tries&& tries) {
+UntangleReport clean_or_least_tangled(Scene& scene, InputSides* kept, Tries&& tries,
+                                      std::optional<InputSides>* tried = nullptr) {
     const Scene input = scene;
     try {
         LeastTangled failures;
         const UntangleReport report = tries(failures);
         if (report.collision_free) return report;
-        return failures.keep(scene, input, report, kept);
+        return failures.keep(scene, input, report, kept, tried);
     } catch (...) {
         scene = input;
         throw;
@@ -408,21 +581,28 @@ std::size_t sides_left_out(const Scene& scene, const InputSides& every, const In
 // some are left out and that is not clean, with every side from the input (the report counts
 // both). Only the tries with every side offer their failed results to `failures`: the others
 // are judged by fewer sides.
+// untangle()'s tries by params' own sides (not in question), then long rounds, then the retry
+// with more passes (original_sides_tries() without the sides left out).
+UntangleReport given_sides_tries(Scene& scene, const UntangleParams& params,
+                                 const ProgressFn& progress, LeastTangled& failures) {
+    return with_retry_passes(
+        scene, params,
+        [&](Scene& t, const UntangleParams& q) {
+            return with_long_rounds(
+                t, q, [](const Scene&) { return false; },
+                [&](Scene& u, const UntangleParams& r) {
+                    return untangle_tries(u, r, progress, failures);
+                },
+                failures);
+        },
+        [](Scene&, const UntangleReport& failed) { return failed; }, failures);
+}
+
 UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
                                     const ProgressFn& progress, InputSides* kept,
                                     LeastTangled& failures) {
     auto all_tries = [&](Scene& s, const UntangleParams& p, LeastTangled& f) {
-        return with_retry_passes(
-            s, p,
-            [&](Scene& t, const UntangleParams& q) {
-                return with_long_rounds(
-                    t, q, [](const Scene&) { return false; },
-                    [&](Scene& u, const UntangleParams& r) {
-                        return untangle_tries(u, r, progress, f);
-                    },
-                    f);
-            },
-            [](Scene&, const UntangleReport& failed) { return failed; }, f);
+        return given_sides_tries(s, p, progress, f);
     };
     InputSides fewer = params.input_sides->off_other_sheets(scene);
     const std::size_t left_out = sides_left_out(scene, *params.input_sides, fewer);
@@ -443,6 +623,42 @@ UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
     cost.add(first);
     cost.add(second);
     return cost.charged_to(second);
+}
+
+// Every try of untangle_inferring_sides() failed, the retries included (`failed`, from
+// `input`): the readings of the small closed loops the inferred sides put on both sides of an
+// open layer (InputSides::loop_readings()), each as a first try, then each as a second try
+// (no self-crossing made); the first clean result is kept (report.loop_reading). A loop lies
+// on one side of a layer, and by_region() never reads a loop split into regions that each
+// agree with itself otherwise.
+UntangleReport loop_readings_tries(Scene& scene, const Scene& input, const UntangleParams& params,
+                                   const ProgressFn& progress, InputSides* kept,
+                                   const UntangleReport& failed, LeastTangled& failures) {
+    const UntangleParams global = with_outside_sides(input, params);
+    const InputSides inferred = record_input_sides(input).by_region(input, global.outside_sides);
+    std::vector<InputSides> readings = inferred.loop_readings(input);
+    TriesCost cost;
+    cost.add(failed);
+    failures.long_rounds = failures.retry_passes = failures.more_passes = false;
+    failures.loop_reading = true;
+    for (bool keep_simple : {false, true})
+        for (std::size_t i = 0; i < readings.size(); ++i) {
+            UntangleParams p = global;
+            p.input_sides = &readings[i];
+            p.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
+            Scene attempt = input;
+            UntangleReport report =
+                untangle_once(attempt, p, progress, keep_simple, failures, &readings[i], i + 1);
+            cost.add(report);
+            if (!report.collision_free) continue;
+            report.inferred_sides = true;
+            report.sides_reading = i + 1;
+            report.loop_reading = true;
+            if (kept) *kept = std::move(readings[i]);
+            scene = std::move(attempt);
+            return cost.charged_to(report);
+        }
+    return cost.charged_to(failed);
 }
 
 UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& params,
@@ -473,7 +689,7 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
         failures.more_passes = false;
         return after_retry(s, failed, std::move(attempt), last);
     };
-    return with_retry_passes(
+    const UntangleReport report = with_retry_passes(
         scene, params,
         [&](Scene& s, const UntangleParams& p) {
             return with_long_rounds(
@@ -484,6 +700,8 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
                 failures);
         },
         more_passes, failures);
+    if (report.collision_free || !params.loop_readings) return report;
+    return loop_readings_tries(scene, input, params, progress, kept, report, failures);
 }
 
 }  // namespace
@@ -498,9 +716,32 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
                                         const ProgressFn& given, InputSides* kept) {
     const ProgressFn progress = numbering_tries(given);
-    return clean_or_least_tangled(scene, kept, [&](LeastTangled& failures) {
-        return inferring_sides_and_retries(scene, params, progress, kept, failures);
-    });
+    const Scene input = scene;
+    std::optional<InputSides> tried;
+    const UntangleReport report = clean_or_least_tangled(
+        scene, kept,
+        [&](LeastTangled& failures) {
+            return inferring_sides_and_retries(scene, params, progress, kept, failures);
+        },
+        &tried);
+    if (report.collision_free || report.input_kept) return report;
+    // The sides the result kept was tried with: the inferred ones it kept, else params' own
+    // (an original's, or the global order).
+    UntangleParams p = with_outside_sides(input, params);
+    if (tried) {
+        p.input_sides = &*tried;
+        p.open_cut_bends = false;
+    }
+    try {
+        UntangleReport last = report;
+        if (report.self_crossings_after > 0 && params.untwist)
+            last = untwisted_try(scene, input, p, report, progress);
+        if (last.collision_free || !params.restart) return last;
+        return restarted_tries(scene, input, p, last, progress);
+    } catch (...) {
+        scene = input;
+        throw;
+    }
 }
 
 }  // namespace strata

@@ -45,6 +45,7 @@ TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded 
         without.long_rounds_factor = 1;
         without.more_passes_factor = 1;  // the tries alone, no retry
         without.retry_passes_factor = 1.0;
+        without.untwist = without.restart = false;  // nor the last resorts
         Scene failed = tangled;
         const UntangleReport before = untangle_inferring_sides(failed, without);
         CHECK_FALSE(before.collision_free);

@@ -25,6 +25,7 @@ TEST_CASE("untangle_inferring_sides: every try once more with more passes when a
     params.long_rounds_factor = 1;  // the retry alone
     params.more_passes_factor = 1;
     params.other_readings = 0;
+    params.loop_readings = params.untwist = params.restart = false;  // the retry alone
     UntangleParams without = params;
     without.retry_passes_factor = 1.0;
     Scene failed = tangled;

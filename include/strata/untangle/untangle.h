@@ -84,6 +84,23 @@ struct UntangleParams {
     /// attempt of its own left, e.g. strata simplify's untangling of a crossing input with
     /// the gap rule before the one without it).
     std::size_t other_readings = 4;
+    /// untangle_inferring_sides() without an original, when every try has failed, the
+    /// retries included: the readings of InputSides::loop_readings() of the inferred sides
+    /// (a small closed loop read on both sides of an open layer, all on one side), each as a
+    /// first try then as a second try; the first clean result is kept (report.loop_reading).
+    bool loop_readings = true;
+    /// untangle_inferring_sides(), when every try has failed and the least tangled result has
+    /// self-crossings (which neither the projection nor the finishing stage takes out): each
+    /// moved by one vertex straight across the other segment's line (the shortest such move
+    /// that leaves fewer segments of the layer met and no more of other layers), then one more
+    /// try from there by the same sides, with no self-crossing made; kept when clean
+    /// (report.untwisted).
+    bool untwist = true;
+    /// untangle_inferring_sides(), when every try has failed (the untwisting too, if it ran)
+    /// and the least tangled result is not the input: untangle()'s two tries, long rounds and
+    /// the retry with more passes once more from that result, by the sides it was tried with;
+    /// kept when clean (report.restarted).
+    bool restart = true;
     /// untangle_inferring_sides() only: when every try fails (without params.input_sides:
     /// inferred sides, global order, other readings; first and second tries), all of them
     /// run once more from the input with gradient_steps x this factor (rounds this many times
@@ -200,6 +217,19 @@ struct UntangleReport {
     /// included, and the result is that of their retry with params.retry_passes_factor times
     /// the passes.
     bool retry_passes = false;
+    /// untangle_inferring_sides() without an original: every try failed, the retries included,
+    /// and the result is a try by a reading that puts a small closed loop read on both sides
+    /// of an open layer all on one side (InputSides::loop_readings(); sides_reading: its
+    /// number there, from 1; params.loop_readings).
+    bool loop_reading = false;
+    /// untangle_inferring_sides(): every try failed, and the least tangled result had
+    /// self-crossings; the result is that one with them taken out one vertex move at a time,
+    /// then one more try from there (params.untwist).
+    bool untwisted = false;
+    /// untangle_inferring_sides(): every try failed (untwisted too, if tried), and the result
+    /// is that of untangle()'s tries, long rounds and more passes once more from the least
+    /// tangled result, by the sides it was tried with (params.restart).
+    bool restarted = false;
     /// untangle_inferring_sides(): every try failed, long rounds included, and the result is the
     /// global order's second try with params.more_passes_factor times the passes.
     bool more_passes = false;
@@ -253,7 +283,11 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// untangle(), when it fails once more with the long rounds, and when those fail all of that
 /// with params.retry_passes_factor times the passes; all of that first without the sides read
 /// at a fold's other sheet (InputSides::off_other_sheets(); report.sides_left_out, `kept` those
-/// sides), then, when some were left out and that is not clean, with every side. When every try
+/// sides), then, when some were left out and that is not clean, with every side. When all of
+/// that fails: without an original, the loop readings (params.loop_readings); then, with or
+/// without, the least tangled result's self-crossings untwisted and one more try from there
+/// (params.untwist), then untangle()'s tries once more from that result (params.restart),
+/// each kept when clean. When every try
 /// fails, the result is the least tangled of all their results and the input, as untangle()
 /// orders them, each try judged by the sides it untangled toward (report.inferred_sides and
 /// sides_reading say which). Same params, progress and throws as untangle(). `kept`: if given,

@@ -1,0 +1,120 @@
+// The last resorts of untangle_inferring_sides(), when every try has failed: the readings of a
+// small loop read on both sides of an open layer (UntangleParams::loop_readings), the
+// untwisting of the least tangled result's self-crossings (UntangleParams::untwist) and the
+// tries once more from that result (UntangleParams::restart). docs/untangle.md, "When every
+// try fails".
+
+#include "strata/geometry/checks.h"
+#include "strata/geometry/input_sides.h"
+#include "strata/io/scene_io.h"
+#include "strata/simplify/scene_families.h"
+#include "strata/untangle/outside_sides.h"
+#include "strata/untangle/untangle.h"
+#include "support/fixtures.h"
+
+#include <catch2/catch.hpp>
+
+using namespace strata;
+
+namespace {
+
+Scene last_resort_scene(const std::string& name) {
+    return read_scene(test::test_data("last_resort/" + name + ".json"));
+}
+
+UntangleParams without_last_resorts() {
+    UntangleParams params;
+    params.loop_readings = false;
+    params.untwist = false;
+    params.restart = false;
+    return params;
+}
+
+}  // namespace
+
+TEST_CASE("untangle_inferring_sides: the least tangled result untwisted when every try fails",
+          "[untangle]") {
+    // The shirt at 95%, seed 75: the roll's return chord crosses the shirt's main part, a
+    // self-crossing of the input that no try takes out; every try ends with it alone.
+    const Scene tangled = last_resort_scene("shirt_roll-0.95-75");
+    REQUIRE(check_scene(tangled).total_self_crossings() == 1);
+    Scene failed = tangled;
+    const UntangleReport before = untangle_inferring_sides(failed, without_last_resorts());
+    CHECK_FALSE(before.collision_free);
+    CHECK(before.self_crossings_after == 1);
+    CHECK_FALSE(before.untwisted);
+
+    UntangleParams params = without_last_resorts();
+    params.untwist = true;
+    Scene out = tangled;
+    const UntangleReport report = untangle_inferring_sides(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.untwisted);
+    CHECK(report.tries > before.tries);
+    CHECK(report.max_displacement > 0.0);
+    const CheckReport c = check_scene(out);
+    CHECK(c.crossing_count == 0);
+    CHECK(c.total_self_crossings() == 0);
+    const Scene original = make_scene(SceneFamily::ShirtRoll, {});
+    const InputSides sides = record_input_sides(original);
+    const InputSides matched = InputSides::matched(sides, original, out);
+    const CheckReport against = test::check_against(out, original, &matched);
+    CHECK(against.is_collision_free());
+    CHECK(against.separations_hold());
+}
+
+TEST_CASE("untangle_inferring_sides: a small loop read on both sides of a layer read on one",
+          "[untangle]") {
+    // The collar at 95%, seed 57: by_region() reads the cord in the collar's fold `-+++-`
+    // (three regions, each agreeing with itself; the original has `+++++`), and no other
+    // reading changes it. Every try fails; the loop's majority side for all of it is clean.
+    const Scene tangled = last_resort_scene("collar_wrap-0.95-57");
+    const std::vector<int> outside = untangling_outside_sides(tangled);
+    const InputSides inferred = infer_input_sides(tangled, {}, outside);
+    const std::vector<InputSides> loops = inferred.loop_readings(tangled);
+    REQUIRE(loops.size() == 2);  // the cord against the collar: + then -
+    for (std::size_t k = 0; k < tangled.layer(1).points.size(); ++k) {
+        CHECK(loops[0].side(1, k, 2) == 1);
+        CHECK(loops[1].side(1, k, 2) == -1);
+    }
+    Scene failed = tangled;
+    const UntangleReport before = untangle_inferring_sides(failed, without_last_resorts());
+    CHECK_FALSE(before.collision_free);
+
+    UntangleParams params = without_last_resorts();
+    params.loop_readings = true;
+    Scene out = tangled;
+    const UntangleReport report = untangle_inferring_sides(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.loop_reading);
+    CHECK(report.inferred_sides);
+    CHECK(report.sides_reading == 1);
+}
+
+TEST_CASE("untangle_inferring_sides: the tries once more from the least tangled result",
+          "[untangle]") {
+    // The collar at 90%, seed 72, with the original's sides: every try fails (2 crossings of
+    // the cord and the collar left at best); from that result the tries are clean.
+    const Scene tangled = last_resort_scene("collar_wrap-0.9-72");
+    const Scene original = make_scene(SceneFamily::CollarWrap, {});
+    const InputSides recorded = record_input_sides(original);
+    const InputSides sides = InputSides::matched(recorded, original, tangled);
+    UntangleParams params = without_last_resorts();
+    params.input_sides = &sides;
+    params.outside_sides = untangling_outside_sides(original);
+    Scene failed = tangled;
+    const UntangleReport before = untangle_inferring_sides(failed, params);
+    CHECK_FALSE(before.collision_free);
+    CHECK_FALSE(before.restarted);
+
+    params.restart = true;
+    Scene out = tangled;
+    const UntangleReport report = untangle_inferring_sides(out, params);
+    CHECK(report.collision_free);
+    CHECK(report.restarted);
+    CHECK(report.tries > before.tries);
+    const InputSides matched = InputSides::matched(recorded, original, out);
+    const CheckReport against = test::check_against(out, original, &matched);
+    CHECK(against.is_collision_free());
+    CHECK(against.separations_hold());
+}
