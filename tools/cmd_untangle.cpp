@@ -177,6 +177,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"loop_reading", r.loop_reading},
                 {"untwisted", r.untwisted},
                 {"restarted", r.restarted},
+                {"ends_by_nearest", r.ends_by_nearest},
                 {"input_kept", r.input_kept},
                 {"gave_up", r.gave_up}};
             if (params.input_sides)

@@ -158,6 +158,7 @@ class GridStack {
             out.in_band = on;
         }
         out.border = layers_[l].store.border(x);
+        out.past_end = out.border < 0.0;
         return out;
     }
 
@@ -181,6 +182,7 @@ class GridStack {
         out = bilinear(v, fx, fy, h_);
         out.in_band = true;
         out.border = layers_[l].store.border(x);
+        out.past_end = out.border < 0.0;
         return out;
     }
 
@@ -194,6 +196,7 @@ class GridStack {
                 out[l] = FieldSample{};
                 out[l].value = band_;
                 out[l].border = layers_[l].store.border(x);
+                out[l].past_end = out[l].border < 0.0;
             }
             return;
         }
@@ -207,6 +210,7 @@ class GridStack {
             out[l] = bilinear(v, fx, fy, h_);
             out[l].in_band = on;
             out[l].border = layers_[l].store.border(x);
+            out[l].past_end = out[l].border < 0.0;
         }
     }
 

@@ -60,7 +60,7 @@ namespace detail {
 
 UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
                               const UntangleParams& params, const ProgressFn& progress,
-                              bool keep_simple, const Box2* region) {
+                              bool keep_simple, const Box2* region, bool ends_by_nearest) {
     validate(params);
     validate_sides(scene, params);
     UntangleReport report;
@@ -81,6 +81,7 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
         // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
         settings.rest_at_start = true;
         settings.keep_simple = keep_simple;
+        settings.ends_by_nearest = ends_by_nearest;
         const bool has_sides = params.input_sides && !params.input_sides->empty();
         check_params.input_sides = has_sides ? params.input_sides : nullptr;
         settings.open_cut_bends = has_sides && params.open_cut_bends;

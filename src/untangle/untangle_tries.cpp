@@ -74,7 +74,8 @@ struct TriesCost {
 class LeastTangled {
   public:
     /// Stamped on the reports offered from now on (the retries' flags).
-    bool long_rounds = false, retry_passes = false, more_passes = false, loop_reading = false;
+    bool long_rounds = false, retry_passes = false, more_passes = false, loop_reading = false,
+         ends_by_nearest = false;
 
     // The result of a failed try (`scene`, `report`); `sides`: the inferred sides it kept
     // (report.inferred_sides), or nullptr for params' own.
@@ -85,6 +86,7 @@ class LeastTangled {
         report.retry_passes = retry_passes;
         report.more_passes = more_passes;
         report.loop_reading = loop_reading;
+        report.ends_by_nearest = ends_by_nearest;
         report.inferred_sides = sides != nullptr;
         report.sides_reading = reading;
         if (!sides && !input_) input_ = as_input(report);
@@ -151,13 +153,14 @@ class LeastTangled {
     std::optional<UntangleReport> input_;
 };
 
-// One untangling of the whole scene; `keep_simple`: EngineSettings::keep_simple. A failed
-// result is offered to `failures` (`sides`, `reading`: LeastTangled::offer()).
+// One untangling of the whole scene; `keep_simple`, `ends_by_nearest`: EngineSettings'. A
+// failed result is offered to `failures` (`sides`, `reading`: LeastTangled::offer()).
 UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const ProgressFn& progress,
                              bool keep_simple, LeastTangled& failures,
-                             const InputSides* sides = nullptr, std::size_t reading = 0) {
-    UntangleReport report =
-        detail::run_untangling(scene, whole_scene_pieces(scene), params, progress, keep_simple);
+                             const InputSides* sides = nullptr, std::size_t reading = 0,
+                             bool ends_by_nearest = false) {
+    UntangleReport report = detail::run_untangling(scene, whole_scene_pieces(scene), params,
+                                                   progress, keep_simple, nullptr, ends_by_nearest);
     report.kept_simple = keep_simple;
     if (!report.collision_free) failures.offer(scene, report, sides, reading);
     return report;
@@ -565,6 +568,35 @@ UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, All
     return after_retry(scene, report, std::move(attempt), second);
 }
 
+// When `failed` (every try of untangle_inferring_sides() from `input`) is not clean, the last
+// retry: from the input, by params' own sides (the global order, or an original's) with the
+// ends read by the nearest feature (EngineSettings::ends_by_nearest), untangle()'s first and
+// second tries; the first clean result is kept (report.ends_by_nearest). The report counts
+// every try. Only a scene every try failed on gets here, so every clean output stays as it was.
+UntangleReport with_ends_by_nearest(Scene& scene, const Scene& input, const UntangleParams& given,
+                                    const ProgressFn& progress, const UntangleReport& failed,
+                                    LeastTangled& failures) {
+    if (failed.collision_free || !given.retry_ends_by_nearest) return failed;
+    const UntangleParams params = with_outside_sides(input, given);
+    TriesCost cost;
+    cost.add(failed);
+    failures.long_rounds = failures.retry_passes = failures.more_passes = false;
+    failures.ends_by_nearest = true;
+    for (bool keep_simple : {false, true}) {
+        Scene attempt = input;
+        UntangleReport report =
+            untangle_once(attempt, params, progress, keep_simple, failures, nullptr, 0, true);
+        cost.add(report);
+        if (!report.collision_free) continue;
+        report.ends_by_nearest = true;
+        failures.ends_by_nearest = false;
+        scene = std::move(attempt);
+        return cost.charged_to(report);
+    }
+    failures.ends_by_nearest = false;
+    return cost.charged_to(failed);
+}
+
 // Vertex sides of `scene` that `every` gives and `kept` leaves out (once per other layer).
 std::size_t sides_left_out(const Scene& scene, const InputSides& every, const InputSides& kept) {
     std::size_t count = 0;
@@ -604,9 +636,12 @@ UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
     auto all_tries = [&](Scene& s, const UntangleParams& p, LeastTangled& f) {
         return given_sides_tries(s, p, progress, f);
     };
+    const Scene input = scene;
     InputSides fewer = params.input_sides->off_other_sheets(scene);
     const std::size_t left_out = sides_left_out(scene, *params.input_sides, fewer);
-    if (left_out == 0) return all_tries(scene, params, failures);
+    if (left_out == 0)
+        return with_ends_by_nearest(scene, input, params, progress,
+                                    all_tries(scene, params, failures), failures);
     UntangleParams without = params;
     without.input_sides = &fewer;
     Scene attempt = scene;
@@ -622,7 +657,7 @@ UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
     TriesCost cost;
     cost.add(first);
     cost.add(second);
-    return cost.charged_to(second);
+    return with_ends_by_nearest(scene, input, params, progress, cost.charged_to(second), failures);
 }
 
 // Every try of untangle_inferring_sides() failed, the retries included (`failed`, from
@@ -689,7 +724,7 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
         failures.more_passes = false;
         return after_retry(s, failed, std::move(attempt), last);
     };
-    const UntangleReport report = with_retry_passes(
+    const UntangleReport failed = with_retry_passes(
         scene, params,
         [&](Scene& s, const UntangleParams& p) {
             return with_long_rounds(
@@ -700,6 +735,8 @@ UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& p
                 failures);
         },
         more_passes, failures);
+    const UntangleReport report =
+        with_ends_by_nearest(scene, input, params, progress, failed, failures);
     if (report.collision_free || !params.loop_readings) return report;
     return loop_readings_tries(scene, input, params, progress, kept, report, failures);
 }

@@ -217,7 +217,8 @@ Scene nested_stars(std::mt19937& rng, std::size_t count, std::size_t n, double g
 
 bool same_sample(const FieldSample& a, const FieldSample& b) {
     return a.value == b.value && a.gradient == b.gradient && a.in_band == b.in_band &&
-           (a.border == b.border || (std::isnan(a.border) && std::isnan(b.border)));
+           (a.border == b.border || (std::isnan(a.border) && std::isnan(b.border))) &&
+           a.past_end == b.past_end;
 }
 
 /// Query points: near every layer's vertices (in and just out of the band) and anywhere in the
@@ -363,6 +364,25 @@ TEST_CASE("open layers: sides, extension past the ends and border field", "[fiel
         CHECK(flipped->sample(Vec2(1.0, -0.25)).value == Approx(-0.25).margin(tol));
         CHECK(flipped->sample(Vec2(2.5, 0.375)).value == Approx(0.375).margin(tol));
         CHECK(flipped->outside_sign() == -1);
+    }
+}
+
+TEST_CASE("past_end: past an end only where the nearest feature is that end", "[field]") {
+    // A layer folded back beside its own start: (0, 0) -> (2, 0), then a fold to the left of
+    // x = 0 and back to (2, 1). Left of x = 0 the border field of the start is negative, but
+    // near the fold the nearest feature is the fold, not the start.
+    const Layer folded = make_layer(
+        {{0, 0}, {1, 0}, {2, 0}, {2, 0.5}, {0, 0.5}, {-0.5, 0.75}, {0, 1}, {2, 1}}, false);
+    for (FieldBackend b :
+         {FieldBackend::Grid, FieldBackend::ExactBrute, FieldBackend::ExactIndexed}) {
+        const auto f = make_field(folded, 1, explicit_params(0.0625, 1.0, b));
+        const FieldSample past = f->sample(Vec2(-0.25, -0.125));  // nearest: the start
+        CHECK(past.border < 0.0);
+        CHECK(past.past_end);
+        const FieldSample fold = f->sample(Vec2(-0.75, 0.625));  // nearest: the fold
+        CHECK(fold.border < 0.0);
+        CHECK(fold.past_end == (b == FieldBackend::Grid));  // the grid cannot tell
+        CHECK_FALSE(f->sample(Vec2(1.0, 0.25)).past_end);
     }
 }
 
@@ -549,8 +569,7 @@ TEST_CASE("indexed field: a vertex carried far away keeps memory bounded and ans
     }
 }
 
-TEST_CASE("indexed field: a small layer far from the origin (buckets from its corner)",
-          "[field]") {
+TEST_CASE("indexed field: a small layer far from the origin (buckets from its corner)", "[field]") {
     // Found by fuzz_pipeline: the legs family at scale 1.3e-3 offset by 8.5e5 was refused
     // ("too large for the bucket size") when buckets were counted from the scene's origin.
     std::mt19937 rng(8);
@@ -564,8 +583,8 @@ TEST_CASE("indexed field: a small layer far from the origin (buckets from its co
     std::uniform_real_distribution<double> u(-0.01, 0.01);
     std::size_t differ = 0;
     for (int q = 0; q < 500; ++q) {
-        const Vec2 x = layer.points[static_cast<std::size_t>(q) % layer.points.size()] +
-                       Vec2(u(rng), u(rng));
+        const Vec2 x =
+            layer.points[static_cast<std::size_t>(q) % layer.points.size()] + Vec2(u(rng), u(rng));
         const FieldSample a = brute->sample(x), b = indexed->sample(x);
         if (a.value != b.value || a.gradient != b.gradient || a.border != b.border) ++differ;
     }

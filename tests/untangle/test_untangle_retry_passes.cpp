@@ -28,6 +28,7 @@ TEST_CASE("untangle_inferring_sides: every try once more with more passes when a
     params.loop_readings = params.untwist = params.restart = false;  // the retry alone
     UntangleParams without = params;
     without.retry_passes_factor = 1.0;
+    without.retry_ends_by_nearest = false;  // which cleans it too, after every retry
     Scene failed = tangled;
     const UntangleReport before = untangle_inferring_sides(failed, without);
     CHECK_FALSE(before.collision_free);

@@ -40,6 +40,10 @@ struct FieldSample {
                            ///< bilinear corners are active (band) voxels.
     /// b(x) of the file comment for open layers (scene units), +inf for closed layers.
     double border = std::numeric_limits<double>::infinity();
+    /// Open layers: x is past an end. Exact backends: the nearest feature is an end vertex (then
+    /// b(x) <= 0); away from the ends b(x) can be negative too (a layer folded back near its
+    /// end), and this stays false there. Grid: b(x) < 0 (it does not know the nearest feature).
+    bool past_end = false;
 };
 
 /// How the fields are evaluated.

@@ -128,6 +128,14 @@ struct UntangleParams {
     /// factor (the projection of a fold cut by chords wanders for a while before it comes out
     /// clean). <= 1: no such retry. docs/untangle.md, "More passes when every try fails".
     int more_passes_factor = 4;
+    /// untangle_inferring_sides() only: when every try has failed (all of the above, with or
+    /// without params.input_sides), the last retry: by params' own sides (the global order, or
+    /// the original's), with an open layer left out of the composition past one of its ends
+    /// only where its nearest feature is that end (not wherever its border field is negative,
+    /// which far from the ends says nothing: a layer folded back beside its own end), the
+    /// first try, then the second (no self-crossing made). false: no such retry.
+    /// docs/untangle.md, "Ends read by the nearest feature".
+    bool retry_ends_by_nearest = true;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
     /// queries as fast (docs/field.md, README "Benchmarks").
@@ -233,6 +241,9 @@ struct UntangleReport {
     /// untangle_inferring_sides(): every try failed, long rounds included, and the result is the
     /// global order's second try with params.more_passes_factor times the passes.
     bool more_passes = false;
+    /// untangle_inferring_sides(): every try failed, and the result is one of the last retry,
+    /// with the ends read by the nearest feature (UntangleParams::retry_ends_by_nearest).
+    bool ends_by_nearest = false;
     /// untangle(), untangle_inferring_sides(): no try came out clean and none was less tangled
     /// than the input, which is the result, unchanged (moved_vertices 0; the counts after are
     /// the input's). When every try fails, the result kept is the least tangled of theirs and
@@ -284,10 +295,11 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// with params.retry_passes_factor times the passes; all of that first without the sides read
 /// at a fold's other sheet (InputSides::off_other_sheets(); report.sides_left_out, `kept` those
 /// sides), then, when some were left out and that is not clean, with every side. When all of
-/// that fails: without an original, the loop readings (params.loop_readings); then, with or
-/// without, the least tangled result's self-crossings untwisted and one more try from there
-/// (params.untwist), then untangle()'s tries once more from that result (params.restart),
-/// each kept when clean. When every try
+/// that fails: params' own sides' first and second tries with the ends read by the nearest
+/// feature (params.retry_ends_by_nearest, report.ends_by_nearest); without an original, the
+/// loop readings (params.loop_readings); then, with or without, the least tangled result's
+/// self-crossings untwisted and one more try from there (params.untwist), then untangle()'s
+/// tries once more from that result (params.restart), each kept when clean. When every try
 /// fails, the result is the least tangled of all their results and the input, as untangle()
 /// orders them, each try judged by the sides it untangled toward (report.inferred_sides and
 /// sides_reading say which). Same params, progress and throws as untangle(). `kept`: if given,

@@ -328,6 +328,7 @@ FieldSample SegmentStore::evaluate(const Vec2& x, const Nearest& n) const {
     if (at_a ? s.a_is_end : s.b_is_end) {
         out.value = glm::dot(x - v, s.normal);
         out.gradient = s.normal;
+        out.past_end = true;
         return out;
     }
     Vec2 pn = at_a ? s.pseudo_a : s.pseudo_b;

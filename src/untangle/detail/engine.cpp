@@ -308,7 +308,10 @@ class Pass {
         for (std::size_t j = 0; j < s.samples.size(); ++j) {
             if (j == layer || !band_boxes_[j].contains(x)) continue;
             s.samples[j] = fields_.field(j).sample_in_band(x);
-            if (!(s.samples[j].in_band && s.samples[j].border > 0.0)) continue;
+            // Past an end of open layer j (border b_j(x) <= 0), x does not take j, or with
+            // EngineSettings::ends_by_nearest only where j's nearest feature is that end.
+            const FieldSample& sj = s.samples[j];
+            if (!sj.in_band || (!(sj.border > 0.0) && (!ends_by_nearest_ || sj.past_end))) continue;
             s.members.push_back(j);
             if (local) take_local_side(layer, j, *local, s.samples[j]);
         }
@@ -620,9 +623,11 @@ class Pass {
     }
 
     void set_keep_simple(bool on) { keep_simple_ = on; }
+    void set_ends_by_nearest(bool on) { ends_by_nearest_ = on; }
 
   private:
-    bool keep_simple_ = false;  // EngineSettings::keep_simple
+    bool keep_simple_ = false;      // EngineSettings::keep_simple
+    bool ends_by_nearest_ = false;  // EngineSettings::ends_by_nearest
     std::vector<Vec2> state_;   // keep_simple()'s scratch
     SegmentBins bins_;
     const SceneFields& fields_;
@@ -842,6 +847,7 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         start = Clock::now();
         Pass engine(work, relations, fields, params, separation, settings.sample_spacing);
         engine.set_keep_simple(settings.keep_simple);
+        engine.set_ends_by_nearest(settings.ends_by_nearest);
         result.converged = false;
         if (!settings.rest_at_start) rest = shapes_of(work, pieces);
         for (int round = 0; round < params.max_rounds; ++round) {

@@ -99,6 +99,13 @@ struct EngineSettings {
     /// SeparationParams::stop_when_wrong_stays of the finishing stage (0: the sweeps run until
     /// they stall). The driver sets 1 for the jobs that hold a rolled vertex.
     int finish_stop_when_wrong_stays = 0;
+    /// The composition leaves out an open layer at a point past one of its ends (border field
+    /// b(x) <= 0) only where the layer's nearest feature is that end vertex
+    /// (FieldSample::past_end; the grid cannot tell and leaves it out wherever b(x) < 0).
+    /// false: wherever b(x) <= 0, which far from the ends says nothing (a layer folded back
+    /// beside its own end: the folded stack's left fold past the ends of its bottom sheets).
+    /// untangle_inferring_sides()' last retry (docs/untangle.md).
+    bool ends_by_nearest = false;
     /// SeparationParams::open_cut_bends of the finishing stage: untangle() sets it from
     /// UntangleParams::open_cut_bends when sides are given; the driver leaves it off.
     bool open_cut_bends = false;

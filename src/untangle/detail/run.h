@@ -14,8 +14,11 @@ namespace strata::detail {
 // their neighbours, or the check is of the whole scene; the checks then look only near it
 // (RegionCheck), with the same verdicts as whole ones. nullptr: whole checks.
 // `keep_simple`: EngineSettings::keep_simple (no vertex move that makes a self-crossing).
+// `ends_by_nearest`: EngineSettings::ends_by_nearest (an open layer left out past its ends
+// only where its nearest feature is the end).
 UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
                               const UntangleParams& params, const ProgressFn& progress,
-                              bool keep_simple = false, const Box2* region = nullptr);
+                              bool keep_simple = false, const Box2* region = nullptr,
+                              bool ends_by_nearest = false);
 
 }  // namespace strata::detail
