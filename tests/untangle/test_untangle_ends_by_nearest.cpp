@@ -58,6 +58,7 @@ TEST_CASE("untangle_inferring_sides: a last retry with the ends read by the near
     params.retry_passes_factor = 1.0;
     params.more_passes_factor = 1;
     params.other_readings = 0;
+    params.loop_readings = params.untwist = params.restart = false;  // nor the last resorts
     UntangleParams without = params;
     without.retry_ends_by_nearest = false;
     Scene failed = tangled;
