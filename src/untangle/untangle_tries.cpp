@@ -460,48 +460,55 @@ bool untwist(Scene& scene) {
     return check.total_self_crossings() == 0;
 }
 
-// The least tangled result `scene` of untangle_inferring_sides() when every try failed
-// (`failed`, its report, from `input`), self-crossings left: untwist() them, then one more
-// try from there (no self-crossing made) by the sides that result was tried with (`p`); kept
-// when clean (report.untwisted), with the counts before and the displacement from `input`.
-// The report counts every try.
-UntangleReport untwisted_try(Scene& scene, const Scene& input, const UntangleParams& p,
-                             const UntangleReport& failed, const ProgressFn& progress) {
-    Scene attempt = scene;
-    if (!untwist(attempt)) return failed;
-    UntangleReport report =
-        detail::run_untangling(attempt, whole_scene_pieces(attempt), p, progress, true);
+// One more attempt from the least tangled result `scene` of untangle_inferring_sides() when
+// every try failed (`failed`, its report, from `input`): `attempt(s)` works on a copy `s` of
+// `scene` and returns its report, or nullopt when it could not start. A clean result is kept,
+// with failed's counts before and the displacement from `input` (as_kept()); the report
+// counts every try.
+template <class Attempt>
+UntangleReport from_least_tangled(Scene& scene, const Scene& input, const UntangleReport& failed,
+                                  Attempt&& attempt) {
+    Scene s = scene;
+    const std::optional<UntangleReport> report = attempt(s);
+    if (!report) return failed;
     TriesCost cost;
     cost.add(failed);
-    cost.add(report);
-    if (!report.collision_free) return cost.charged_to(failed);
-    UntangleReport kept = as_kept(failed, report, attempt, input);
-    kept.untwisted = true;
-    scene = std::move(attempt);
+    cost.add(*report);
+    if (!report->collision_free) return cost.charged_to(failed);
+    const UntangleReport kept = as_kept(failed, *report, s, input);
+    scene = std::move(s);
     return cost.charged_to(kept);
+}
+
+// The least tangled result `scene` (`failed`, from `input`), self-crossings left: untwist()
+// them, then one more try from there (no self-crossing made) by the sides that result was tried
+// with (`p`); kept when clean (report.untwisted).
+UntangleReport untwisted_try(Scene& scene, const Scene& input, const UntangleParams& p,
+                             const UntangleReport& failed, const ProgressFn& progress) {
+    UntangleReport report =
+        from_least_tangled(scene, input, failed, [&](Scene& s) -> std::optional<UntangleReport> {
+            if (!untwist(s)) return std::nullopt;
+            return detail::run_untangling(s, whole_scene_pieces(s), p, progress, true);
+        });
+    report.untwisted = report.collision_free;
+    return report;
 }
 
 UntangleReport given_sides_tries(Scene& scene, const UntangleParams& params,
                                  const ProgressFn& progress, LeastTangled& failures);
 
-// The least tangled result `scene` of untangle_inferring_sides() when every try failed
-// (`failed`, its report, from `input`), after untwisted_try() if it ran: untangle()'s tries,
-// long rounds and the retry with more passes once more, from that result, by the sides it was
-// tried with (`p`); kept when clean (report.restarted), with the counts before and the
-// displacement from `input`. The report counts every try.
+// The least tangled result `scene` (`failed`, from `input`), after untwisted_try() if it ran:
+// untangle()'s tries, long rounds and the retry with more passes once more, from that result,
+// by the sides it was tried with (`p`); kept when clean (report.restarted).
 UntangleReport restarted_tries(Scene& scene, const Scene& input, const UntangleParams& p,
                                const UntangleReport& failed, const ProgressFn& progress) {
-    Scene attempt = scene;
-    LeastTangled not_kept;  // a failed restart keeps the result it started from
-    const UntangleReport report = given_sides_tries(attempt, p, progress, not_kept);
-    TriesCost cost;
-    cost.add(failed);
-    cost.add(report);
-    if (!report.collision_free) return cost.charged_to(failed);
-    UntangleReport kept = as_kept(failed, report, attempt, input);
-    kept.restarted = true;
-    scene = std::move(attempt);
-    return cost.charged_to(kept);
+    UntangleReport report =
+        from_least_tangled(scene, input, failed, [&](Scene& s) -> std::optional<UntangleReport> {
+            LeastTangled not_kept;  // a failed restart keeps the result it started from
+            return given_sides_tries(s, p, progress, not_kept);
+        });
+    report.restarted = report.collision_free;
+    return report;
 }
 
 // `progress` with the tries told apart: every try counts its rounds from 0 again, so a fraction
