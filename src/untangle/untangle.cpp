@@ -58,6 +58,20 @@ std::size_t rolled_kept(const Scene& scene, const InputSides& sides,
 
 namespace detail {
 
+void measure_displacement(const Scene& result, const Scene& from, UntangleReport& report) {
+    const Vec2 size = from.bounds().size();
+    const double diagonal =
+        std::max(std::hypot(size.x, size.y), std::numeric_limits<double>::min());
+    report.max_displacement = 0.0;
+    report.moved_vertices = 0;
+    for (std::size_t l = 0; l < result.size(); ++l)
+        for (std::size_t v = 0; v < result.layer(l).points.size(); ++v) {
+            const double d = glm::distance(result.layer(l).points[v], from.layer(l).points[v]);
+            report.max_displacement = std::max(report.max_displacement, d);
+            if (d > 1e-12 * diagonal) ++report.moved_vertices;
+        }
+}
+
 UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
                               const UntangleParams& params, const ProgressFn& progress,
                               bool keep_simple, const Box2* region, bool ends_by_nearest) {
@@ -177,13 +191,7 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
             report.rolled_kept = rolled_kept(original, *params.input_sides, settings.outside_signs,
                                              report.rolled_vertices, check);
         }
-        for (std::size_t l = 0; l < scene.size(); ++l)
-            for (std::size_t v = 0; v < scene.layer(l).points.size(); ++v) {
-                const double d =
-                    glm::distance(scene.layer(l).points[v], original.layer(l).points[v]);
-                report.max_displacement = std::max(report.max_displacement, d);
-                if (d > 1e-12 * settings.diagonal) ++report.moved_vertices;
-            }
+        measure_displacement(scene, original, report);
     } catch (...) {
         scene = original;
         throw;

@@ -391,15 +391,7 @@ UntangleReport as_kept(const UntangleReport& failed, const UntangleReport& repor
     kept.min_separation_ratio_after = report.min_separation_ratio_after;
     kept.rolled_kept = report.rolled_kept;
     kept.input_kept = false;
-    kept.max_displacement = 0.0;
-    kept.moved_vertices = 0;
-    const double diagonal = glm::length(input.bounds().size());
-    for (std::size_t l = 0; l < result.size(); ++l)
-        for (std::size_t v = 0; v < result.layer(l).points.size(); ++v) {
-            const double d = glm::distance(result.layer(l).points[v], input.layer(l).points[v]);
-            kept.max_displacement = std::max(kept.max_displacement, d);
-            if (d > 1e-12 * diagonal) ++kept.moved_vertices;
-        }
+    detail::measure_displacement(result, input, kept);
     return kept;
 }
 
@@ -614,12 +606,6 @@ std::size_t sides_left_out(const Scene& scene, const InputSides& every, const In
     return count;
 }
 
-// With params.input_sides given (an original's, not in question): untangle()'s tries, long
-// rounds and the retry with more passes, first without the sides read at a fold's other sheet
-// (InputSides::off_other_sheets(): `kept` receives those sides when that is clean), then, when
-// some are left out and that is not clean, with every side from the input (the report counts
-// both). Only the tries with every side offer their failed results to `failures`: the others
-// are judged by fewer sides.
 // untangle()'s tries by params' own sides (not in question), then long rounds, then the retry
 // with more passes (original_sides_tries() without the sides left out).
 UntangleReport given_sides_tries(Scene& scene, const UntangleParams& params,
@@ -637,30 +623,33 @@ UntangleReport given_sides_tries(Scene& scene, const UntangleParams& params,
         [](Scene&, const UntangleReport& failed) { return failed; }, failures);
 }
 
+// With params.input_sides given (an original's, not in question): given_sides_tries(), first
+// without the sides read at a fold's other sheet (InputSides::off_other_sheets(): `kept`
+// receives those sides when that is clean), then, when some are left out and that is not
+// clean, with every side from the input (the report counts both); when that fails too,
+// with_ends_by_nearest(). Only the tries with every side offer their failed results to
+// `failures`: the others are judged by fewer sides.
 UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
                                     const ProgressFn& progress, InputSides* kept,
                                     LeastTangled& failures) {
-    auto all_tries = [&](Scene& s, const UntangleParams& p, LeastTangled& f) {
-        return given_sides_tries(s, p, progress, f);
-    };
     const Scene input = scene;
     InputSides fewer = params.input_sides->off_other_sheets(scene);
     const std::size_t left_out = sides_left_out(scene, *params.input_sides, fewer);
     if (left_out == 0)
         return with_ends_by_nearest(scene, input, params, progress,
-                                    all_tries(scene, params, failures), failures);
+                                    given_sides_tries(scene, params, progress, failures), failures);
     UntangleParams without = params;
     without.input_sides = &fewer;
     Scene attempt = scene;
     LeastTangled not_offered;
-    UntangleReport first = all_tries(attempt, without, not_offered);
+    UntangleReport first = given_sides_tries(attempt, without, progress, not_offered);
     if (first.collision_free) {
         first.sides_left_out = left_out;
         scene = std::move(attempt);
         if (kept) *kept = std::move(fewer);
         return first;
     }
-    UntangleReport second = all_tries(scene, params, failures);
+    UntangleReport second = given_sides_tries(scene, params, progress, failures);
     TriesCost cost;
     cost.add(first);
     cost.add(second);
@@ -677,8 +666,8 @@ UntangleReport loop_readings_tries(Scene& scene, const Scene& input, const Untan
                                    const ProgressFn& progress, InputSides* kept,
                                    const UntangleReport& failed, LeastTangled& failures) {
     const UntangleParams global = with_outside_sides(input, params);
-    const InputSides inferred = record_input_sides(input).by_region(input, global.outside_sides);
-    std::vector<InputSides> readings = inferred.loop_readings(input);
+    std::vector<InputSides> readings =
+        infer_input_sides(input, {}, global.outside_sides).loop_readings(input);
     TriesCost cost;
     cost.add(failed);
     failures.long_rounds = failures.retry_passes = failures.more_passes = false;

@@ -21,4 +21,9 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
                               bool keep_simple = false, const Box2* region = nullptr,
                               bool ends_by_nearest = false);
 
+// report.max_displacement and moved_vertices of `result` against `from` (the same layers and
+// vertex counts): the largest vertex move, and the vertices moved by more than 1e-12 x the
+// diagonal of `from`'s bounds.
+void measure_displacement(const Scene& result, const Scene& from, UntangleReport& report);
+
 }  // namespace strata::detail
