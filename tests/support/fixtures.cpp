@@ -118,4 +118,10 @@ CheckReport check_against(const Scene& out, const Scene& original, const InputSi
     return check_scene(out, judged);
 }
 
+CheckReport check_by_original(const Scene& out, const Scene& original) {
+    const InputSides recorded = record_input_sides(original);
+    const InputSides matched = InputSides::matched(recorded, original, out);
+    return check_against(out, original, &matched);
+}
+
 }  // namespace strata::test

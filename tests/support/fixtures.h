@@ -91,6 +91,11 @@ inline Scene collar_wrapped_cord(std::size_t points, double gap_in_segments) {
 CheckReport check_against(const Scene& out, const Scene& original,
                           const InputSides* sides = nullptr);
 
+/// check_against() as `strata check OUT --reference ORIG` judges: every vertex of `out` takes
+/// the sides recorded in `original` at its vertex nearest to where it ended
+/// (InputSides::matched()).
+CheckReport check_by_original(const Scene& out, const Scene& original);
+
 /// tests/data/<name>
 std::filesystem::path test_data(const std::string& name);
 /// ../shared/data/<name> beside the project, or empty when that folder is absent.
