@@ -1,10 +1,11 @@
 // Benchmarks of the collision-free simplification (issue 5), ratios measured in one run.
 //
 //   strata_bench_simplify paper [--repeat N] [--only global|local] [--stretch long|short]
-//                               [--margin M]...
+//                               [--margin M]... [--backend indexed|grid]
 //                                           paper section 5.2: local vs global untangling
 //                                           (best of N, default 3; the local box grown by
-//                                           each M, default 0.3 and 0.1)
+//                                           each M, default 0.3 and 0.1; fields of the
+//                                           backend, default indexed, in both runs)
 //   strata_bench_simplify scenes [options]  generated 5/8-layer scenes, per backend and
 //                                           schedule (options: see the usage line)
 //
@@ -82,7 +83,7 @@ long peak_rss_mb() {
 // the best time of each is kept. `only`: "global" or "local" runs only that mode
 // (profiling), "" both.
 void paper(std::size_t first, std::size_t last, int repeat, const std::string& only,
-           std::vector<double> margins) {
+           std::vector<double> margins, FieldBackend backend) {
     const Scene input = folded_stack(5, 2000, 10.0 * 2000.0 / 600.0);
     std::vector<Layer> layers = input.layers();
     Layer& middle = layers[2];
@@ -123,7 +124,7 @@ void paper(std::size_t first, std::size_t last, int repeat, const std::string& o
         params.gradient_steps = 30;
         params.alpha = 0.8;
         params.beta = 0.9;
-        params.field.backend = FieldBackend::ExactIndexed;
+        params.field.backend = backend;
         if (!converge) {  // at most 150 iterations: 5 rounds, one pass, no early stop
             params.max_rounds = 5;
             params.max_passes = 1;
@@ -310,6 +311,7 @@ int main(int argc, char** argv) {
         int repeat = 3;
         std::string only, stretch;
         std::vector<double> margins;
+        FieldBackend backend = FieldBackend::ExactIndexed;
         for (int i = 2; i + 1 < argc; i += 2) {
             const std::string key = argv[i], value = argv[i + 1];
             if (key == "--repeat" && std::atoi(value.c_str()) >= 1) {
@@ -320,14 +322,16 @@ int main(int argc, char** argv) {
                 stretch = value;
             } else if (key == "--margin" && is_margin(value)) {
                 margins.push_back(std::strtod(value.c_str(), nullptr));
+            } else if (key == "--backend" && (value == "indexed" || value == "grid")) {
+                backend = value == "grid" ? FieldBackend::Grid : FieldBackend::ExactIndexed;
             } else {
                 std::fprintf(stderr, "strata_bench_simplify: bad paper option %s %s\n", key.c_str(),
                              value.c_str());
                 return 2;
             }
         }
-        if (stretch != "short") paper(400, 1200, repeat, only, margins);
-        if (stretch != "long") paper(400, 480, repeat, only, margins);
+        if (stretch != "short") paper(400, 1200, repeat, only, margins, backend);
+        if (stretch != "long") paper(400, 480, repeat, only, margins, backend);
     } else if (what == "scenes") {
         SceneFilter filter;
         for (int i = 2; i + 1 < argc; i += 2) {
@@ -379,7 +383,8 @@ int main(int argc, char** argv) {
     } else {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper [--repeat N] [--only global|local] "
-                     "[--stretch long|short] [--margin M]... | scenes [--min N] [--max N] "
+                     "[--stretch long|short] [--margin M]... [--backend indexed|grid] | scenes "
+                     "[--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
                      "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
                      "[--give-up 0,1] [--finish 0,1] [--decimator random|visvalingam|max-error] "

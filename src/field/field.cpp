@@ -50,6 +50,12 @@ void validate(const FieldParams& params) {
     check_length(params.expected_penetration, "expected_penetration");
     check_length(params.band_margin_voxels, "band_margin_voxels");
     check_length(params.bucket_size, "bucket_size");
+    const Box2& r = params.region;
+    if (!r.is_empty() && !(std::isfinite(r.min.x) && std::isfinite(r.min.y) &&
+                           std::isfinite(r.max.x) && std::isfinite(r.max.y)))
+        throw InvalidInput("FieldParams: params.region must be empty or finite (got [" +
+                           format_number(r.min.x) + ", " + format_number(r.max.x) + "] x [" +
+                           format_number(r.min.y) + ", " + format_number(r.max.y) + "])");
 }
 
 ResolvedFieldParams resolve(const FieldParams& params, const Scene& scene) {
@@ -85,6 +91,7 @@ ResolvedFieldParams resolve(const FieldParams& params, const Scene& scene) {
                      3.0 * out.voxel_size);
     }
     out.bucket_size = params.bucket_size > 0.0 ? params.bucket_size : 2.0 * median;
+    out.region = params.region;
     return out;
 }
 

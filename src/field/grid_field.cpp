@@ -115,11 +115,15 @@ FieldSample bilinear(const float (&v)[4], double fx, double fy, double h) {
 /// - internal nodes without children are tiles, so the tree equals a fresh build's.
 /// Each plane depends only on its layer and its leaf, so updating one layer's planes where its
 /// geometry changed equals a rebuild.
+/// With a region (FieldParams::region), only the leaves of the region's leaf range exist (the
+/// region grown by the band and a voxel, so that a sample within band of the region reads the
+/// corners a whole grid would); a walk that leaves that range takes the exact sign instead.
 class GridStack {
   public:
     GridStack(const std::vector<const Layer*>& layers, const std::vector<int>& outside_signs,
               const ResolvedFieldParams& params)
         : h_(params.voxel_size), band_(params.band_width) {
+        set_region(params.region);
         layers_.reserve(layers.size());
         for (std::size_t l = 0; l < layers.size(); ++l) {
             const Layer& layer = *layers[l];
@@ -465,8 +469,15 @@ class GridStack {
     // sign is the same. Tiles are skipped whole; the walk ends past the rightmost leaf.
     float walk(ConstAccessor& acc, int i, int j, int z) const {
         const auto bg = static_cast<float>(band_);
-        long x = static_cast<long>(i) + 1;
-        while (x <= max_leaf_x_) {
+        long x = static_cast<long>(i) + 1, end = max_leaf_x_;
+        if (limited_) {
+            // Leaves exist only in the region's range: a walk from outside it, or one that
+            // leaves it, could skip leaves a whole grid has.
+            if (!in_region(floor_div(i, kLeafDim), floor_div(j, kLeafDim)))
+                return exact_off_value(layers_[static_cast<std::size_t>(z)], i, j);
+            end = std::min(end, (leaf_i1_ + 1) * kLeafDim - 1);
+        }
+        while (x <= end) {
             const openvdb::Coord xyz(static_cast<int>(x), j, z);
             if (const Leaf* leaf = acc.probeConstLeaf(xyz))
                 return leaf->getValue(Leaf::coordToOffset(xyz)) < 0.f ? -bg : bg;
@@ -475,7 +486,46 @@ class GridStack {
                                          : static_cast<long>(depth == 1 ? N1::DIM : N2::DIM);
             x = (floor_div(x, span) + 1) * span;
         }
-        return bg;
+        return limited_ ? exact_off_value(layers_[static_cast<std::size_t>(z)], i, j) : bg;
+    }
+
+    // Layer d's value at voxel (i, j) out of its band: +-band with its exact sign for a closed
+    // layer, +band for an open one (as off_plane_value()).
+    float exact_off_value(const LayerData& d, long i, long j) const {
+        const auto bg = static_cast<float>(band_);
+        if (!d.closed) return bg;
+        const Vec2 p(static_cast<double>(i) * h_, static_cast<double>(j) * h_);
+        Nearest best;
+        nearest_slot(d.index, d.store, p, best);
+        return d.store.evaluate(p, best).value < 0.0 ? -bg : bg;
+    }
+
+    // The leaf range [leaf_i0_, leaf_i1_] x [leaf_j0_, leaf_j1_] of `region` (FieldParams).
+    void set_region(const Box2& region) {
+        limited_ = !region.is_empty();
+        if (!limited_) return;
+        const Box2 r = region.inflated(band_);
+        const auto index = [&](double v, double offset) {
+            const double g = std::floor(v / h_) + offset;
+            return static_cast<long>(std::clamp(g, -kMaxIndex, kMaxIndex));
+        };
+        leaf_i0_ = floor_div(index(r.min.x, -1.0), kLeafDim);
+        leaf_i1_ = floor_div(index(r.max.x, 2.0), kLeafDim);
+        leaf_j0_ = floor_div(index(r.min.y, -1.0), kLeafDim);
+        leaf_j1_ = floor_div(index(r.max.y, 2.0), kLeafDim);
+    }
+
+    bool in_region(long li, long lj) const {
+        return !limited_ || (li >= leaf_i0_ && li <= leaf_i1_ && lj >= leaf_j0_ && lj <= leaf_j1_);
+    }
+
+    // Clips the leaf range [li0, li1] x [lj0, lj1] to the region's.
+    void clip_to_region(long& li0, long& li1, long& lj0, long& lj1) const {
+        if (!limited_) return;
+        li0 = std::max(li0, leaf_i0_);
+        li1 = std::min(li1, leaf_i1_);
+        lj0 = std::max(lj0, leaf_j0_);
+        lj1 = std::min(lj1, leaf_j1_);
     }
 
     // Leaves of the layer's row holding a voxel centre (i h, j h) within the band of the
@@ -488,17 +538,21 @@ class GridStack {
         const long j0 = static_cast<long>(std::ceil(box.min.y / h_));
         const long j1 = static_cast<long>(std::floor(box.max.y / h_));
         if (i0 > i1 || j0 > j1) return;
-        for (long li = floor_div(i0, kLeafDim); li <= floor_div(i1, kLeafDim); ++li)
-            for (long lj = floor_div(j0, kLeafDim); lj <= floor_div(j1, kLeafDim); ++lj)
-                f(leaf_key(li, lj));
+        long li0 = floor_div(i0, kLeafDim), li1 = floor_div(i1, kLeafDim);
+        long lj0 = floor_div(j0, kLeafDim), lj1 = floor_div(j1, kLeafDim);
+        clip_to_region(li0, li1, lj0, lj1);
+        for (long li = li0; li <= li1; ++li)
+            for (long lj = lj0; lj <= lj1; ++lj) f(leaf_key(li, lj));
     }
 
     // Appends the keys of the existing leaves of row `row_z` that touch `box`.
     void leaves_touching(const Box2& box, int row_z, std::vector<std::uint64_t>& keys) const {
-        const long li0 = floor_div(static_cast<long>(std::floor(box.min.x / h_)), kLeafDim);
-        const long li1 = floor_div(static_cast<long>(std::ceil(box.max.x / h_)), kLeafDim);
-        const long lj0 = floor_div(static_cast<long>(std::floor(box.min.y / h_)), kLeafDim);
-        const long lj1 = floor_div(static_cast<long>(std::ceil(box.max.y / h_)), kLeafDim);
+        long li0 = floor_div(static_cast<long>(std::floor(box.min.x / h_)), kLeafDim);
+        long li1 = floor_div(static_cast<long>(std::ceil(box.max.x / h_)), kLeafDim);
+        long lj0 = floor_div(static_cast<long>(std::floor(box.min.y / h_)), kLeafDim);
+        long lj1 = floor_div(static_cast<long>(std::ceil(box.max.y / h_)), kLeafDim);
+        clip_to_region(li0, li1, lj0, lj1);
+        if (li0 > li1 || lj0 > lj1) return;
         const auto positions =
             static_cast<double>(li1 - li0 + 1) * static_cast<double>(lj1 - lj0 + 1);
         if (positions <= 4.0 * static_cast<double>(leaf_count_)) {
@@ -753,6 +807,8 @@ class GridStack {
     StackGrid::Ptr grid_;
     std::size_t leaf_count_ = 0;
     long max_leaf_x_ = std::numeric_limits<long>::min();  // >= every leaf's last voxel x
+    bool limited_ = false;  // FieldParams::region given: leaves only in the range below
+    long leaf_i0_ = 0, leaf_i1_ = -1, leaf_j0_ = 0, leaf_j1_ = -1;
 };
 
 namespace {

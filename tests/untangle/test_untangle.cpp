@@ -181,6 +181,43 @@ TEST_CASE("local untangling reports what a whole-scene check of its result says"
     }
 }
 
+TEST_CASE("local untangling with grid fields of its box gives the whole grid's result",
+          "[untangle][localize]") {
+    // untangle_local() builds the grid only around its free vertices (FieldParams::region):
+    // every sample it takes reads what the whole grid (a region over the whole scene) reads.
+    std::vector<Layer> open;
+    for (int l = 0; l < 3; ++l) {
+        Layer layer;
+        layer.name = "open" + std::to_string(l);
+        layer.thickness = 0.02;
+        for (int i = 0; i <= 400; ++i) {
+            const double x = 0.05 * i;
+            const double dent = l == 1 && i > 195 && i < 205 ? 0.25 : 0.0;
+            layer.points.emplace_back(x, 0.1 * std::sin(x) + 0.15 * l - dent);
+        }
+        open.push_back(std::move(layer));
+    }
+    const std::vector<Scene> scenes = {
+        Scene({circle("inner", {0.3, 0.0}, 1.0, 256), circle("outer", {0, 0}, 1.2, 256)}),
+        Scene(open)};
+    const std::vector<Box2> boxes = {Box2{{0.8, -0.9}, {1.5, 0.9}}, Box2{{9.6, -0.5}, {10.4, 0.6}}};
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+        UntangleParams params;
+        params.field.backend = FieldBackend::Grid;
+        Scene part = scenes[k];
+        const UntangleReport a = untangle_local(part, boxes[k], 7, params);
+        params.field.region = scenes[k].bounds();
+        Scene whole = scenes[k];
+        const UntangleReport b = untangle_local(whole, boxes[k], 7, params);
+        INFO("scene " << k);
+        CHECK(a.collision_free);
+        CHECK(a.crossings_before > 0);
+        CHECK(a.rounds == b.rounds);
+        for (std::size_t l = 0; l < part.size(); ++l)
+            CHECK(part.layer(l).points == whole.layer(l).points);
+    }
+}
+
 TEST_CASE("an untangling that cannot finish in its passes gives up early when asked",
           "[untangle]") {
     // Two straight layers 0.05 apart that must keep 0.2, with steps clamped to 0.05% of an

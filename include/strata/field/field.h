@@ -71,6 +71,13 @@ struct FieldParams {
     /// Bucket size of the ExactIndexed backend, scene units, >= 0. 0 = automatic: twice the
     /// median segment length.
     double bucket_size = 0.0;
+    /// Grid backend: where the caller will sample, scene units (empty, the default: anywhere).
+    /// The grid is then built and updated only within `region` grown by the band width, so a
+    /// local untangling pays for its box, not for the whole scene. Samples there equal a whole
+    /// grid's (open layers out of the band aside: +band_width past the region's right edge);
+    /// farther out they read out of the band, with a closed layer's exact sign. Ignored by the
+    /// exact backends. Finite when not empty.
+    Box2 region = {};
 };
 
 /// Throws InvalidInput naming the first out-of-range field.
@@ -82,6 +89,7 @@ struct ResolvedFieldParams {
     double voxel_size = 0.0;   ///< h, scene units, > 0.
     double band_width = 0.0;   ///< Band half-width, scene units, > 0.
     double bucket_size = 0.0;  ///< ExactIndexed bucket size, scene units, > 0.
+    Box2 region;               ///< FieldParams::region (empty: the whole scene).
 };
 
 /// Resolves the automatic values of `params` from `scene`.

@@ -138,7 +138,10 @@ struct UntangleParams {
     bool retry_ends_by_nearest = true;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
-    /// queries as fast (docs/field.md, README "Benchmarks").
+    /// queries as fast (docs/field.md, README "Benchmarks"). FieldParams::region is set by the
+    /// untangling: the box of the free vertices and their neighbours where they lie in a part
+    /// of the scene (untangle_local(), the simplification's jobs; a region given here is
+    /// added to it), none where every vertex is free.
     FieldParams field = {FieldBackend::ExactIndexed};
     CompositionParams composition;  ///< Composition solver settings.
     /// Outside sides of the open layers (+1 or -1 per layer, see outside_side(); entries of

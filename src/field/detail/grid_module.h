@@ -21,7 +21,7 @@
 namespace strata::detail {
 
 /// Bumped whenever GridModule or a type it passes changes layout.
-inline constexpr int kGridModuleAbi = 1;
+inline constexpr int kGridModuleAbi = 2;
 
 /// The Grid backend's entry points (backends.h, grid_inspect.h, vdb_io.h).
 struct GridModule {

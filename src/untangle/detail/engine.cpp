@@ -813,13 +813,48 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     // rebuild and, for the grid, recomputes only the leaves near the moves).
     std::optional<SceneFields> built;
     std::vector<std::vector<Vec2>> built_points;
+    // The fields are sampled only at the free vertices and on their segments. Where these
+    // lie in a part of the scene (a local run), grid fields cover only their box
+    // (FieldParams::region, exact up to a band width beyond it): a pass that starts with them
+    // more than half a band width out of it builds the fields again.
+    auto samples_box = [&] {
+        Box2 box;
+        for (const Piece& piece : pieces) {
+            const std::vector<Vec2>& x = work.layer(piece.layer).points;
+            const std::size_t m = piece.vertices.size();
+            for (std::size_t k = 0; k < m; ++k) {
+                if (!piece.is_free[k]) continue;
+                box.extend(x[piece.vertices[k]]);
+                if (k > 0 || piece.is_whole_loop) box.extend(x[piece.vertices[(k + m - 1) % m]]);
+                if (k + 1 < m || piece.is_whole_loop) box.extend(x[piece.vertices[(k + 1) % m]]);
+            }
+        }
+        return box;
+    };
+    const Box2 bounds = work.bounds();
+    const bool local_grid = params.field.backend == FieldBackend::Grid && [&] {
+        const Box2 box = samples_box();
+        return !(box.contains(bounds.min) && box.contains(bounds.max));
+    }();
+    FieldParams field_params = params.field;
+    if (!local_grid) field_params.region = Box2{};  // sampled everywhere
     const bool give_up = params.give_up_when_stalled || settings.give_up_when_stalled;
     std::vector<double> worst;  // give_up: worst violation at each pass's start
     for (int pass = 0; pass < params.max_passes && !result.ok && !result.gave_up; ++pass) {
         ++result.passes;
         start = Clock::now();
+        Box2 box;
+        if (local_grid) box = samples_box();
+        if (built && local_grid) {
+            const Box2 safe = field_params.region.inflated(0.5 * built->params().band_width);
+            if (!(safe.contains(box.min) && safe.contains(box.max))) {
+                built.reset();
+                built_points.clear();
+            }
+        }
         if (!built) {
-            built.emplace(work, params.field, settings.outside_signs);
+            if (local_grid) field_params.region.extend(box);
+            built.emplace(work, field_params, settings.outside_signs);
             for (const Layer& layer : work.layers()) built_points.push_back(layer.points);
         } else {
             for (std::size_t j = 0; j < work.size(); ++j) {
