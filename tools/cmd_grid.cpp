@@ -45,8 +45,30 @@ struct GridOptions {
     std::string layer;
     bool info = false;
     int width = 800;
+    std::vector<double> region;  // --region X0,Y0,X1,Y1, empty: none
     FieldParams params;
 };
+
+/// The box of `--region X0,Y0,X1,Y1`.
+/// @throws InvalidInput not four finite numbers with X0 <= X1 and Y0 <= Y1.
+Box2 region_box(const std::vector<double>& v) {
+    const auto shown = [&] {
+        std::string out;
+        for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + format_number(v[i]);
+        return out;
+    };
+    if (v.size() != 4 ||
+        !std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); }) ||
+        v[0] > v[2] || v[1] > v[3])
+        throw InvalidInput(
+            "strata grid: --region must be X0,Y0,X1,Y1, four finite numbers with "
+            "X0 <= X1 and Y0 <= Y1 (got " +
+            shown() + ")");
+    Box2 box;
+    box.extend(Vec2(v[0], v[1]));
+    box.extend(Vec2(v[2], v[3]));
+    return box;
+}
 
 void append_png(void* context, void* data, int size) {
     auto* out = static_cast<std::string*>(context);
@@ -54,11 +76,16 @@ void append_png(void* context, void* data, int size) {
 }
 
 /// Heat map of one layer's field (blue inside, red outside, brighter near the curve), the zero
-/// contour in black and the band edge in grey; pixels span the layer's box plus the band.
+/// contour in black and the band edge in grey; pixels span the layer's box plus twice the band,
+/// or, with a region, the region plus the band (where the grid is built).
 void write_png(const Scene& scene, const SceneFields& fields, std::size_t layer, int width,
                const std::filesystem::path& path) {
     const double band = fields.params().band_width;
-    const Box2 box = scene.layer(layer).bounds().inflated(2.0 * band);
+    const Box2& region = fields.params().region;
+    Box2 box = region.is_empty() ? scene.layer(layer).bounds().inflated(2.0 * band)
+                                 : region.inflated(band);
+    // A region of zero width or height: a square of the band around it.
+    if (!(box.size().x > 0.0)) box = box.inflated(band);
     const double px = box.size().x / static_cast<double>(width);
     const int height = std::max(1, static_cast<int>(std::ceil(box.size().y / px)));
     const auto w = static_cast<std::size_t>(width), h = static_cast<std::size_t>(height);
@@ -122,6 +149,11 @@ Run add_grid_command(CLI::App& app) {
     cmd->add_option("--band", opt->params.band_width,
                     "Band half-width, scene units (0 = auto: thickness + penetration + 2 voxels)")
         ->capture_default_str();
+    cmd->add_option("--region", opt->region,
+                    "Build the grid only around the box X0,Y0,X1,Y1 (scene units; within a band "
+                    "width of it): a part of a large scene, fast")
+        ->expected(4)
+        ->delimiter(',');
     return [opt]() {
         if (opt->vdb.empty() && opt->png.empty() && !opt->info)
             throw InvalidInput(
@@ -129,6 +161,7 @@ Run add_grid_command(CLI::App& app) {
         for (const auto& out : {opt->vdb, opt->png})
             if (!out.empty()) ensure_not_an_input(out, {opt->input});
         opt->params.backend = FieldBackend::Grid;
+        if (!opt->region.empty()) opt->params.region = region_box(opt->region);
         validate(opt->params);
         const Scene scene = read_scene(opt->input);
         std::vector<int> sides(scene.size());
@@ -149,14 +182,24 @@ Run add_grid_command(CLI::App& app) {
         if (opt->info) {
             std::cout << "voxel size " << format_number(fields.params().voxel_size) << ", band "
                       << format_number(fields.params().band_width) << " (scene units"
-                      << (scene.units().empty() ? "" : ": " + shown_name(scene.units())) << ")\n";
+                      << (scene.units().empty() ? "" : ": " + shown_name(scene.units())) << ")";
+            if (const Box2& r = fields.params().region; !r.is_empty())
+                std::cout << ", only within a band of the region [" << format_number(r.min.x)
+                          << ", " << format_number(r.min.y) << "] - [" << format_number(r.max.x)
+                          << ", " << format_number(r.max.y) << "]";
+            std::cout << "\n";
             for (std::size_t i = 0; i < fields.size(); ++i) {
                 const FieldStats st = fields.field(i).stats();
                 std::cout << shown_name(scene.layer(i).name) << ": " << st.segments << " segments, "
                           << st.active_voxels << " active voxels, " << st.leaves << " leaves, "
                           << st.memory_bytes << " bytes ("
                           << st.memory_bytes / std::max<std::size_t>(st.segments, 1)
-                          << " per segment), bbox [" << format_number(st.bounds.min.x) << ", "
+                          << " per segment), bbox ";
+                if (st.bounds.is_empty()) {
+                    std::cout << "none\n";  // no band voxel in the region
+                    continue;
+                }
+                std::cout << "[" << format_number(st.bounds.min.x) << ", "
                           << format_number(st.bounds.min.y) << "] - ["
                           << format_number(st.bounds.max.x) << ", "
                           << format_number(st.bounds.max.y) << "]\n";
