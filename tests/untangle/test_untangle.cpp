@@ -36,6 +36,24 @@ double max_move(const Scene& a, const Scene& b, std::size_t layer) {
     return d;
 }
 
+// Three open layers 0.15 apart, the middle one dented 0.25 down through the lower one over
+// its 9 middle vertices: `segments` + 1 vertices a layer, 0.05 apart.
+Scene dented_open_stack(int segments) {
+    std::vector<Layer> open;
+    for (int l = 0; l < 3; ++l) {
+        Layer layer;
+        layer.name = "open" + std::to_string(l);
+        layer.thickness = 0.02;
+        for (int i = 0; i <= segments; ++i) {
+            const double x = 0.05 * i;
+            const double dent = l == 1 && std::abs(2 * i - segments) < 10 ? 0.25 : 0.0;
+            layer.points.emplace_back(x, 0.1 * std::sin(x) + 0.15 * l - dent);
+        }
+        open.push_back(std::move(layer));
+    }
+    return Scene(open);
+}
+
 UntangleParams exact_params() {
     UntangleParams params;
     params.field.backend = FieldBackend::ExactIndexed;
@@ -149,19 +167,7 @@ TEST_CASE("local untangling reports what a whole-scene check of its result says"
     std::vector<Scene> scenes;
     scenes.push_back(
         Scene({circle("inner", {0.3, 0.0}, 1.0, 64), circle("outer", {0, 0}, 1.2, 64)}));
-    std::vector<Layer> open;
-    for (int l = 0; l < 3; ++l) {
-        Layer layer;
-        layer.name = "open" + std::to_string(l);
-        layer.thickness = 0.02;
-        for (int i = 0; i <= 200; ++i) {
-            const double x = 0.05 * i;
-            const double dent = l == 1 && i > 95 && i < 105 ? 0.25 : 0.0;
-            layer.points.emplace_back(x, 0.1 * std::sin(x) + 0.15 * l - dent);
-        }
-        open.push_back(std::move(layer));
-    }
-    scenes.emplace_back(std::move(open));
+    scenes.push_back(dented_open_stack(200));
     const std::vector<Box2> boxes = {Box2{{0.8, -0.9}, {1.5, 0.9}}, Box2{{4.6, -0.5}, {5.4, 0.6}}};
     for (std::size_t k = 0; k < scenes.size(); ++k) {
         Scene scene = scenes[k];
@@ -185,21 +191,9 @@ TEST_CASE("local untangling with grid fields of its box gives the whole grid's r
           "[untangle][localize]") {
     // untangle_local() builds the grid only around its free vertices (FieldParams::region):
     // every sample it takes reads what the whole grid (a region over the whole scene) reads.
-    std::vector<Layer> open;
-    for (int l = 0; l < 3; ++l) {
-        Layer layer;
-        layer.name = "open" + std::to_string(l);
-        layer.thickness = 0.02;
-        for (int i = 0; i <= 400; ++i) {
-            const double x = 0.05 * i;
-            const double dent = l == 1 && i > 195 && i < 205 ? 0.25 : 0.0;
-            layer.points.emplace_back(x, 0.1 * std::sin(x) + 0.15 * l - dent);
-        }
-        open.push_back(std::move(layer));
-    }
     const std::vector<Scene> scenes = {
         Scene({circle("inner", {0.3, 0.0}, 1.0, 256), circle("outer", {0, 0}, 1.2, 256)}),
-        Scene(open)};
+        dented_open_stack(400)};
     const std::vector<Box2> boxes = {Box2{{0.8, -0.9}, {1.5, 0.9}}, Box2{{9.6, -0.5}, {10.4, 0.6}}};
     for (std::size_t k = 0; k < scenes.size(); ++k) {
         UntangleParams params;
