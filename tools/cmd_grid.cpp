@@ -82,10 +82,8 @@ void write_png(const Scene& scene, const SceneFields& fields, std::size_t layer,
                const std::filesystem::path& path) {
     const double band = fields.params().band_width;
     const Box2& region = fields.params().region;
-    Box2 box = region.is_empty() ? scene.layer(layer).bounds().inflated(2.0 * band)
-                                 : region.inflated(band);
-    // A region of zero width or height: a square of the band around it.
-    if (!(box.size().x > 0.0)) box = box.inflated(band);
+    const Box2 box = region.is_empty() ? scene.layer(layer).bounds().inflated(2.0 * band)
+                                       : region.inflated(band);
     const double px = box.size().x / static_cast<double>(width);
     const int height = std::max(1, static_cast<int>(std::ceil(box.size().y / px)));
     const auto w = static_cast<std::size_t>(width), h = static_cast<std::size_t>(height);
