@@ -16,7 +16,7 @@ using namespace strata;
 
 namespace {
 
-// Three nested circles and an open arc through the outer two: closed and open layers.
+// Three nested circles and an open arc between the outer two: closed and open layers.
 Scene circles_and_arc() {
     std::vector<Layer> layers = test::nested_circles(3, 400, 1.0, 0.1).layers();
     Layer arc;
