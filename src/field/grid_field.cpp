@@ -490,7 +490,7 @@ class GridStack {
     }
 
     // Layer d's value at voxel (i, j) out of its band: +-band with its exact sign for a closed
-    // layer, +band for an open one (as off_plane_value()).
+    // layer, +band for an open one.
     float exact_off_value(const LayerData& d, long i, long j) const {
         const auto bg = static_cast<float>(band_);
         if (!d.closed) return bg;
@@ -644,13 +644,7 @@ class GridStack {
     // +band for an open layer, whose sign out of the band is not meaningful (and could change
     // far from an edit of an end segment).
     float off_plane_value(const LayerData& d, std::uint64_t key) const {
-        const auto bg = static_cast<float>(band_);
-        if (!d.closed) return bg;
-        const Vec2 p(static_cast<double>(key_i(key) * kLeafDim) * h_,
-                     static_cast<double>(key_j(key) * kLeafDim) * h_);
-        Nearest best;
-        nearest_slot(d.index, d.store, p, best);
-        return d.store.evaluate(p, best).value < 0.0 ? -bg : bg;
+        return exact_off_value(d, key_i(key) * kLeafDim, key_j(key) * kLeafDim);
     }
 
     static void write_plane(Leaf& leaf, int z, const Plane& plane) {
