@@ -546,6 +546,25 @@ TEST_CASE("untangle_inferring_sides: without rolled regions the inferred sides a
     CHECK(c.total_self_crossings() == 0);
 }
 
+namespace {
+
+// The collar at 95% decimated naively with `seed` and untangled by untangle_inferring_sides():
+// its report; its result is checked clean as `strata check OUT --reference ORIG` judges it
+// (the original's sides, matched by position).
+UntangleReport collar_95_inferred(unsigned seed) {
+    const Scene input = make_scene(SceneFamily::CollarWrap);
+    const Scene tangled = naive_decimation(input, 0.95, seed);
+    REQUIRE(check_scene(tangled).crossing_count > 0);
+    Scene out = tangled;
+    const UntangleReport report = untangle_inferring_sides(out);
+    const CheckReport c = test::check_by_original(out, input);
+    CHECK(c.is_collision_free());
+    CHECK(c.separations_hold());
+    return report;
+}
+
+}  // namespace
+
 TEST_CASE("untangle_inferring_sides: rolled regions get both tries before the global order",
           "[untangle][rolled]") {
     // Out of sample (300 points a layer): the collar at 95%, seeds 36 and 49. Every rolled
@@ -553,21 +572,13 @@ TEST_CASE("untangle_inferring_sides: rolled regions get both tries before the gl
     // sides fails; the global order's first try then came out clean with the cord pushed out of
     // the collar's fold (dirty by the original). The second try by the inferred sides (no
     // self-crossing made) comes out clean with the fold kept.
-    const Scene input = make_scene(SceneFamily::CollarWrap);
     for (unsigned seed : {36u, 49u}) {
         INFO("seed " << seed);
-        const Scene tangled = naive_decimation(input, 0.95, seed);
-        REQUIRE(check_scene(tangled).crossing_count > 0);
-        Scene out = tangled;
-        const UntangleReport report = untangle_inferring_sides(out);
+        const UntangleReport report = collar_95_inferred(seed);
         CHECK(report.collision_free);
         CHECK(report.inferred_sides);
         CHECK(report.kept_simple);
         CHECK(report.tries == 2);  // no global order's try
-        // Judged as `strata check OUT --reference ORIG`: the original's sides, matched by position.
-        const CheckReport c = test::check_by_original(out, input);
-        CHECK(c.is_collision_free());
-        CHECK(c.separations_hold());
     }
 }
 
@@ -577,19 +588,12 @@ TEST_CASE("untangle_inferring_sides: rolled regions get long rounds before the g
     // is inferred on its original side, but both tries by those sides fail with rounds of 10
     // steps; the global order's first try then came out clean with the cord out of the fold. With
     // rounds of 30 the inferred sides come out clean, the fold kept.
-    const Scene input = make_scene(SceneFamily::CollarWrap);
     for (unsigned seed : {20u, 82u}) {
         INFO("seed " << seed);
-        const Scene tangled = naive_decimation(input, 0.95, seed);
-        REQUIRE(check_scene(tangled).crossing_count > 0);
-        Scene out = tangled;
-        const UntangleReport report = untangle_inferring_sides(out);
+        const UntangleReport report = collar_95_inferred(seed);
         CHECK(report.collision_free);
         CHECK(report.inferred_sides);
         CHECK(report.long_rounds);
-        const CheckReport c = test::check_by_original(out, input);
-        CHECK(c.is_collision_free());
-        CHECK(c.separations_hold());
     }
 }
 

@@ -14,6 +14,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <utility>
+
 using namespace strata;
 
 namespace {
@@ -30,6 +32,19 @@ UntangleParams without_last_resorts() {
     return params;
 }
 
+// untangle_inferring_sides() of `tangled` with `params`, then with the last resort `resort` on
+// too (its result in `out`): the two reports, without and with.
+std::pair<UntangleReport, UntangleReport> without_then_with(const Scene& tangled,
+                                                            UntangleParams params,
+                                                            bool UntangleParams::*resort,
+                                                            Scene& out) {
+    Scene failed = tangled;
+    const UntangleReport without = untangle_inferring_sides(failed, params);
+    params.*resort = true;
+    out = tangled;
+    return {without, untangle_inferring_sides(out, params)};
+}
+
 }  // namespace
 
 TEST_CASE("untangle_inferring_sides: the least tangled result untwisted when every try fails",
@@ -38,16 +53,12 @@ TEST_CASE("untangle_inferring_sides: the least tangled result untwisted when eve
     // self-crossing of the input that no try takes out; every try ends with it alone.
     const Scene tangled = last_resort_scene("shirt_roll-0.95-75");
     REQUIRE(check_scene(tangled).total_self_crossings() == 1);
-    Scene failed = tangled;
-    const UntangleReport before = untangle_inferring_sides(failed, without_last_resorts());
+    Scene out;
+    const auto [before, report] =
+        without_then_with(tangled, without_last_resorts(), &UntangleParams::untwist, out);
     CHECK_FALSE(before.collision_free);
     CHECK(before.self_crossings_after == 1);
     CHECK_FALSE(before.untwisted);
-
-    UntangleParams params = without_last_resorts();
-    params.untwist = true;
-    Scene out = tangled;
-    const UntangleReport report = untangle_inferring_sides(out, params);
     CHECK(report.collision_free);
     CHECK(report.untwisted);
     CHECK(report.tries > before.tries);
@@ -75,14 +86,10 @@ TEST_CASE("untangle_inferring_sides: a small loop read on both sides of a layer 
         CHECK(loops[0].side(1, k, 2) == 1);
         CHECK(loops[1].side(1, k, 2) == -1);
     }
-    Scene failed = tangled;
-    const UntangleReport before = untangle_inferring_sides(failed, without_last_resorts());
+    Scene out;
+    const auto [before, report] =
+        without_then_with(tangled, without_last_resorts(), &UntangleParams::loop_readings, out);
     CHECK_FALSE(before.collision_free);
-
-    UntangleParams params = without_last_resorts();
-    params.loop_readings = true;
-    Scene out = tangled;
-    const UntangleReport report = untangle_inferring_sides(out, params);
     CHECK(report.collision_free);
     CHECK(report.loop_reading);
     CHECK(report.inferred_sides);
@@ -100,14 +107,10 @@ TEST_CASE("untangle_inferring_sides: the tries once more from the least tangled 
     UntangleParams params = without_last_resorts();
     params.input_sides = &sides;
     params.outside_sides = untangling_outside_sides(original);
-    Scene failed = tangled;
-    const UntangleReport before = untangle_inferring_sides(failed, params);
+    Scene out;
+    const auto [before, report] = without_then_with(tangled, params, &UntangleParams::restart, out);
     CHECK_FALSE(before.collision_free);
     CHECK_FALSE(before.restarted);
-
-    params.restart = true;
-    Scene out = tangled;
-    const UntangleReport report = untangle_inferring_sides(out, params);
     CHECK(report.collision_free);
     CHECK(report.restarted);
     CHECK(report.tries > before.tries);
