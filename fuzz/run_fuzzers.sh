@@ -8,7 +8,10 @@
 # fuzzer found anything. FUZZ_KEEP_GOING=1: libFuzzer's fork mode (one worker), which goes on
 # past a crash and saves every one (for long runs). FUZZ_SEED=N: libFuzzer's -seed (CI uses a
 # fixed one, so that a short run repeats the same mutations; 0, the default, a random one).
+# STRATA_FUZZ_ROUNDS=N: fuzz_pipeline cancels an untangling after N rounds (default 30 here;
+# see fuzz_pipeline.cpp), so that a short run gets past its slow seeds.
 set -uo pipefail
+export STRATA_FUZZ_ROUNDS="${STRATA_FUZZ_ROUNDS:-30}"
 here="$(cd "$(dirname "$0")" && pwd)"
 build="$(cd "$1" && pwd)"
 seconds="$2"
