@@ -6,6 +6,10 @@
 //                                           (best of N, default 3; the local box grown by
 //                                           each M, default 0.3 and 0.1; fields of the
 //                                           backend, default indexed, in both runs)
+//   strata_bench_simplify backends [--repeat N]
+//                                           where grid fields pay in a global untangling:
+//                                           paper 5.2's stacks resampled and thinner,
+//                                           indexed against grid (best of N, default 3)
 //   strata_bench_simplify scenes [options]  generated 5/8-layer scenes, per backend and
 //                                           schedule (options: see the usage line)
 //
@@ -81,21 +85,25 @@ long peak_rss_mb() {
 // simplification step. The local box is the stretch's box grown by each of `margins` (scene
 // units) in turn. Each run is repeated `repeat` times, global and the local ones in turn, and
 // the best time of each is kept. `only`: "global" or "local" runs only that mode
-// (profiling), "" both.
-void paper(std::size_t first, std::size_t last, int repeat, const std::string& only,
-           std::vector<double> margins, FieldBackend backend) {
+// (profiling), "" both. paper_scene() makes the tangled scene and the stretch's box.
+Scene paper_scene(std::size_t first, std::size_t last, Box2& box) {
     const Scene input = folded_stack(5, 2000, 10.0 * 2000.0 / 600.0);
     std::vector<Layer> layers = input.layers();
     Layer& middle = layers[2];
     std::vector<Vec2> kept;
-    Box2 box;
     for (std::size_t i = 0; i < middle.points.size(); ++i) {
         const bool stretch = i > first && i < last;
         if (!stretch || i % 40 == 0) kept.push_back(middle.points[i]);
         if (stretch) box.extend(middle.points[i]);
     }
     middle.points = kept;
-    const Scene tangled(layers);
+    return Scene(layers);
+}
+
+void paper(std::size_t first, std::size_t last, int repeat, const std::string& only,
+           std::vector<double> margins, FieldBackend backend) {
+    Box2 box;
+    const Scene tangled = paper_scene(first, last, box);
     // By default the box of the earlier runs (the stretch's box grown by 0.3) and the one the
     // simplification grows around a removal (docs/simplify.md, step 2): by twice the nested
     // thickness, the thickness of the middle layer and of every layer nested with it (0.1
@@ -166,6 +174,80 @@ void paper(std::size_t first, std::size_t last, int repeat, const std::string& o
                 rg.seconds_fields, rg.seconds_untangle, rg.seconds_check, rg.seconds_finish,
                 rl[m].seconds_fields, rl[m].seconds_untangle, rl[m].seconds_check,
                 rl[m].seconds_finish);
+        }
+    }
+}
+
+// `scene` with every layer's thickness times `thickness` and its vertices resampled: every
+// `every`-th kept (the first and, for an open layer, the last too), or with `every` 0 a
+// midpoint inserted in every segment.
+Scene resampled(const Scene& scene, double thickness, std::size_t every) {
+    std::vector<Layer> layers = scene.layers();
+    for (Layer& layer : layers) {
+        layer.thickness *= thickness;
+        std::vector<Vec2> points;
+        const std::vector<Vec2>& p = layer.points;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            if (every == 0) {
+                points.push_back(p[i]);
+                if (i + 1 < p.size() || layer.closed)
+                    points.push_back(0.5 * (p[i] + p[(i + 1) % p.size()]));
+            } else if (i % every == 0 || (!layer.closed && i + 1 == p.size())) {
+                points.push_back(p[i]);
+            }
+        }
+        layer.points = points;
+    }
+    return Scene(layers);
+}
+
+// Where the grid backend pays in a global untangling: paper 5.2's tangled stacks (both
+// stretches), resampled (a midpoint in every segment, every 2nd or 4th vertex kept, the
+// thickness scaled with the segment length) and with thinner layers (thickness x 0.75, 0.5,
+// 0.25: the automatic voxel is then capped by half the smallest separation, and the band
+// holds more voxels a segment). untangle_inferring_sides() with default parameters, as
+// `strata untangle` runs; indexed and grid in turn, best of `repeat` each.
+void backends(int repeat) {
+    std::printf(
+        "global untangling, indexed against grid fields, default UntangleParams; best of %d\n",
+        repeat);
+    std::printf("%-7s %-9s %-9s %8s %9s %10s %8s %7s %6s %6s\n", "stretch", "vertices", "thickness",
+                "segments", "voxels/seg", "indexed s", "grid s", "grid/ix", "clean", "passes");
+    struct Variant {
+        const char* name;
+        double thickness;
+        std::size_t every;
+    };
+    const Variant variants[] = {{"x2", 0.5, 0},  {"x1", 1.0, 1}, {"x1/2", 2.0, 2}, {"x1/4", 4.0, 4},
+                                {"x1", 0.75, 1}, {"x1", 0.5, 1}, {"x1", 0.25, 1}};
+    for (const bool long_stretch : {true, false}) {
+        Box2 box;
+        const Scene base = long_stretch ? paper_scene(400, 1200, box) : paper_scene(400, 480, box);
+        for (const Variant& v : variants) {
+            const Scene tangled = resampled(base, v.thickness, v.every);
+            FieldParams grid_params;
+            grid_params.backend = FieldBackend::Grid;
+            const FieldStats stats = SceneFields(tangled, grid_params).total_stats();
+            double best[2] = {1e300, 1e300};
+            bool clean = true;
+            int passes[2] = {0, 0};
+            for (int k = 0; k < repeat; ++k)
+                for (int b = 0; b < 2; ++b) {
+                    UntangleParams params;
+                    params.field.backend = b == 0 ? FieldBackend::ExactIndexed : FieldBackend::Grid;
+                    Scene s = tangled;
+                    const double t = now();
+                    const UntangleReport r = untangle_inferring_sides(s, params);
+                    best[b] = std::min(best[b], now() - t);
+                    clean = clean && r.collision_free;
+                    passes[b] = r.passes;
+                }
+            std::printf(
+                "%-7s %-9s %9.4f %8zu %10.0f %10.3f %8.3f %7.2f %6s %3d/%-3d\n",
+                long_stretch ? "long" : "short", v.name, 0.01 * v.thickness, stats.segments,
+                static_cast<double>(stats.active_voxels) / static_cast<double>(stats.segments),
+                best[0], best[1], best[1] / best[0], clean ? "yes" : "NO", passes[0], passes[1]);
+            std::fflush(stdout);
         }
     }
 }
@@ -332,6 +414,13 @@ int main(int argc, char** argv) {
         }
         if (stretch != "short") paper(400, 1200, repeat, only, margins, backend);
         if (stretch != "long") paper(400, 480, repeat, only, margins, backend);
+    } else if (what == "backends") {
+        const int repeat = argc == 4 && std::string(argv[2]) == "--repeat" ? std::atoi(argv[3]) : 3;
+        if (repeat < 1 || (argc != 2 && argc != 4)) {
+            std::fprintf(stderr, "usage: strata_bench_simplify backends [--repeat N]\n");
+            return 2;
+        }
+        backends(repeat);
     } else if (what == "scenes") {
         SceneFilter filter;
         for (int i = 2; i + 1 < argc; i += 2) {
@@ -383,7 +472,8 @@ int main(int argc, char** argv) {
     } else {
         std::fprintf(stderr,
                      "usage: strata_bench_simplify paper [--repeat N] [--only global|local] "
-                     "[--stretch long|short] [--margin M]... [--backend indexed|grid] | scenes "
+                     "[--stretch long|short] [--margin M]... [--backend indexed|grid] | backends "
+                     "[--repeat N] | scenes "
                      "[--min N] [--max N] "
                      "[--layers 5|8] [--remove FRACTION] [--backend indexed|grid] "
                      "[--schedule deferred|immediate] [--threads N[,N...]] [--batch N[,N...]] "
