@@ -2,6 +2,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "simplify_batch.h"
+#include "time_limit.h"
 
 #include "strata/core/error.h"
 #include "strata/core/format.h"
@@ -192,6 +193,8 @@ Run add_simplify_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")
         ->capture_default_str();
+    add_time_limit_option(*cmd, opt->time_limit,
+                          "each input (a slice of a batch on its own clock)");
     cmd->add_flag("--global", p.global,
                   "Untangle the whole scene after each tangling removal (slow; comparison)");
     cmd->add_flag("--no-untangle", opt->naive, "Naive decimation only");
@@ -240,8 +243,21 @@ Run add_simplify_command(CLI::App& app) {
             std::cerr << "strata: note: " << files.front() << ": " << note << '\n';
         const std::string name = fs::path(files.front()).filename().string();
         std::optional<InputUntangling> untangled;
-        const std::optional<Scene> prepared =
-            prepare_input(input, files.front(), o.input_crossings, o.params, untangled);
+        const TimeLimit deadline(o.time_limit);
+        const ProgressFn progress = deadline.around(terminal_progress());
+        // Stopped at the time limit: nothing written, exit 1 (main()).
+        const auto within_limit = [&](auto&& run) {
+            try {
+                return run();
+            } catch (const Cancelled&) {
+                if (deadline.is_past()) throw TimeLimitReached(deadline.message(files.front()));
+                throw;
+            }
+        };
+        const std::optional<Scene> prepared = within_limit([&] {
+            return prepare_input(input, files.front(), o.input_crossings, o.params, untangled,
+                                 progress);
+        });
         if (!prepared) {
             std::fprintf(stderr,
                          "strata: %s: the input crosses; skipped (--input-crossings skip), "
@@ -261,7 +277,8 @@ Run add_simplify_command(CLI::App& app) {
                       "of the input, as 'strata untangle' does"
                     : "");
         Scene result, naive;
-        const Outcome out = run_one(*prepared, o, terminal_progress(), result, &naive);
+        const Outcome out =
+            within_limit([&] { return run_one(*prepared, o, progress, result, &naive); });
         write_scene(result, o.output);
         const SimplifyReport* naive_report = out.naive ? &*out.naive : nullptr;
         if (!o.svg.empty()) {

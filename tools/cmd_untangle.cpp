@@ -2,7 +2,9 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "reference.h"
+#include "time_limit.h"
 
+#include "strata/core/error.h"
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
 #include "strata/io/atomic_file.h"
@@ -27,6 +29,7 @@ namespace {
 struct UntangleOptions {
     std::string input, output, svg, report, reference;
     double thickness = 0.0;
+    double time_limit = 0.0;  // seconds, 0: none
     bool no_shape_matching = false;
     bool no_finish = false;
     bool infer_sides = false;
@@ -80,6 +83,7 @@ Run add_untangle_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--voxel", p.field.voxel_size, "Grid voxel size (scene units; 0 = auto)")
         ->capture_default_str();
+    add_time_limit_option(*cmd, opt->time_limit, "the untangling");
     cmd->add_flag("--give-up-when-stalled", p.give_up_when_stalled,
                   "End a try early when its violation, extrapolated, would not fall enough by the "
                   "pass cap");
@@ -88,6 +92,7 @@ Run add_untangle_command(CLI::App& app) {
     cmd->add_flag("--no-finish", opt->no_finish,
                   "No finishing stage (exact separation constraints): the paper's method alone");
     return [opt]() {
+        const TimeLimit limit(opt->time_limit);
         UntangleParams params = opt->params;
         if (opt->no_shape_matching) params.shape = ShapeMode::None;
         if (opt->no_finish) params.finish_separations = false;
@@ -123,9 +128,15 @@ Run add_untangle_command(CLI::App& app) {
         // the first tries fail), the tries of untangle_inferring_sides(); --global-order and
         // --infer-sides: one untangle().
         const bool fallback = !opt->global_order && !opt->infer_sides;
-        const UntangleReport r =
-            fallback ? untangle_inferring_sides(scene, params, terminal_progress(), &inferred)
-                     : untangle(scene, params, terminal_progress());
+        const ProgressFn progress = limit.around(terminal_progress());
+        UntangleReport r;
+        try {
+            r = fallback ? untangle_inferring_sides(scene, params, progress, &inferred)
+                         : untangle(scene, params, progress);
+        } catch (const Cancelled&) {
+            if (limit.is_past()) throw TimeLimitReached(limit.message(opt->input));
+            throw;
+        }
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         // The input's rolled regions were kept, or the original's sides but those read at a

@@ -1,5 +1,6 @@
 // strata: the command-line front end. Each verb lives in its own cmd_*.cpp.
 #include "commands.h"
+#include "time_limit.h"
 
 #include "strata/core/error.h"
 
@@ -43,6 +44,9 @@ int main(int argc, char** argv) {
         std::cerr << "strata: error: " << e.what() << '\n';
         return 2;
     } catch (const strata::Cancelled& e) {
+        std::cerr << "strata: error: " << e.what() << '\n';
+        return 1;
+    } catch (const strata::cli::TimeLimitReached& e) {
         std::cerr << "strata: error: " << e.what() << '\n';
         return 1;
     } catch (const std::bad_alloc&) {

@@ -2,6 +2,7 @@
 #include "simplify_batch.h"
 
 #include "cli_util.h"
+#include "time_limit.h"
 
 #include "strata/core/error.h"
 #include "strata/core/format.h"
@@ -142,10 +143,10 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check) {
 // (untangle_inferring_sides()). `after`:
 // the check of the result (against the inferred sides when they were taken).
 Scene untangle_input(const Scene& start, const UntangleParams& u, InputUntangling& info,
-                     CheckReport& after) {
+                     CheckReport& after, const ProgressFn& progress) {
     Scene scene = start;
     InputSides inferred;
-    info.report = untangle_inferring_sides(scene, u, {}, &inferred);
+    info.report = untangle_inferring_sides(scene, u, progress, &inferred);
     CheckParams check_params;
     if (info.report.inferred_sides) {
         check_params.outside_sides = untangling_outside_sides(start);
@@ -157,7 +158,8 @@ Scene untangle_input(const Scene& start, const UntangleParams& u, InputUntanglin
 
 std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
                                    const SimplifyParams& params,
-                                   std::optional<InputUntangling>& untangled) {
+                                   std::optional<InputUntangling>& untangled,
+                                   const ProgressFn& progress) {
     // The input is its own reference for the sides of open layers (a rolled part lies on the
     // other side of the global order): only crossings, self-crossings and the nesting of
     // closed layers can make it tangled.
@@ -215,7 +217,7 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
         u.loop_readings = last && defaults.loop_readings;
         u.untwist = last && defaults.untwist;
         u.restart = last && defaults.restart;
-        scene = untangle_input(starts[i], u, info, after);
+        scene = untangle_input(starts[i], u, info, after, progress);
         if (after.is_collision_free()) break;
     }
     if (!after.is_collision_free())
@@ -285,20 +287,24 @@ Outcome simplify_slice(const std::string& input, const std::string& output,
     Outcome o;
     o.input = input;
     o.output = output;
+    const TimeLimit limit(opt.time_limit);
     try {
         ensure_not_an_input(o.output, {fs::path(input)});
         const Scene read = with_default_thickness(read_scene(input), opt.thickness);
+        const ProgressFn progress = limit.around({});
         const std::optional<Scene> prepared =
-            prepare_input(read, input, opt.input_crossings, opt.params, o.untangled);
+            prepare_input(read, input, opt.input_crossings, opt.params, o.untangled, progress);
         if (!prepared) {
             o.skipped = true;
             return o;
         }
         Scene result;
-        Outcome r = run_one(*prepared, opt, {}, result, nullptr);
+        Outcome r = run_one(*prepared, opt, progress, result, nullptr);
         write_scene(result, o.output);
         o.report = std::move(r.report);
         o.naive = std::move(r.naive);
+    } catch (const Cancelled&) {
+        o.error = limit.is_past() ? limit.message(input) : "cancelled";
     } catch (const std::bad_alloc&) {
         o.error = "out of memory: this slice needs more memory than the process may use";
     } catch (const std::exception& e) {

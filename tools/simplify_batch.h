@@ -31,6 +31,9 @@ struct SimplifyOptions {
     bool no_finish = false;
     bool naive = false;
     bool compare_naive = false;  ///< Also run the naive decimation, for the numbers.
+    /// Seconds one input may take (`--time-limit`; 0: none): past it, its untangling or
+    /// simplification stops (TimeLimitReached; a slice of a batch fails, the others go on).
+    double time_limit = 0.0;
     InputCrossings input_crossings = InputCrossings::Untangle;
     SimplifyParams params;
 };
@@ -66,10 +69,12 @@ std::string tangle_summary(const Scene& scene, const CheckReport& check);
 
 /// Simplification keeps a collision-free scene so. An input that already crosses is untangled
 /// first (InputCrossings::Untangle: the global untangling, which cannot mend a layer that
-/// crosses itself), or refused (Fail: InvalidInput; Skip: std::nullopt).
+/// crosses itself; `progress` false cancels it: Cancelled), or refused (Fail: InvalidInput;
+/// Skip: std::nullopt).
 std::optional<Scene> prepare_input(const Scene& input, const std::string& name, InputCrossings mode,
                                    const SimplifyParams& params,
-                                   std::optional<InputUntangling>& untangled);
+                                   std::optional<InputUntangling>& untangled,
+                                   const ProgressFn& progress = {});
 
 /// Simplifies one scene; the naive run (no untangling) is made beside it when asked for.
 Outcome run_one(const Scene& input, const SimplifyOptions& opt, const ProgressFn& progress,
@@ -82,7 +87,8 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs);
 std::string batch_output(const std::string& folder, const std::string& input);
 
 /// One slice of a batch: reads `input` (with opt.thickness), prepares it (opt.input_crossings),
-/// simplifies it and writes `output` atomically. Never throws: a failure is Outcome::error.
+/// simplifies it and writes `output` atomically, within opt.time_limit from its start. Never
+/// throws: a failure is Outcome::error.
 Outcome simplify_slice(const std::string& input, const std::string& output,
                        const SimplifyOptions& opt);
 

@@ -10,6 +10,7 @@
 #include "simplify_batch.h"
 
 #include "strata/core/error.h"
+#include "strata/core/format.h"
 #include "strata/field/field.h"
 #include "strata/geometry/checks.h"
 #include "strata/geometry/scene.h"
@@ -169,7 +170,12 @@ cli::SimplifyOptions simplify_options(const py::dict& kw) {
             o.no_finish = !v.cast<bool>();
         else if (key == "input_crossings")
             o.input_crossings = parse_input_crossings(v.cast<std::string>());
-        else
+        else if (key == "time_limit") {
+            o.time_limit = v.cast<double>();
+            if (!std::isfinite(o.time_limit) || o.time_limit < 0.0)
+                throw InvalidInput("time_limit must be a number of seconds >= 0 (got " +
+                                   format_number(o.time_limit) + ")");
+        } else
             throw py::type_error("simplify: unexpected keyword argument '" + key + "'");
     }
     // As the CLI does after parsing.
@@ -411,16 +417,21 @@ PYBIND11_MODULE(_strata, m) {
             throw InvalidInput(
                 "simplify: input_crossings 'skip' is for strata.batch (use "
                 "'untangle' or 'fail')");
+        if (opt.time_limit > 0.0)
+            throw InvalidInput(
+                "simplify: time_limit is for strata.batch (a progress callback that returns "
+                "False stops strata.simplify())");
         cli::Outcome out;
         std::optional<cli::InputUntangling> untangled;
         Scene result;
         {
             py::gil_scoped_release release;
             const Scene input = cli::with_default_thickness(scene, opt.thickness);
-            const std::optional<Scene> prepared =
-                cli::prepare_input(input, "simplify", opt.input_crossings, opt.params, untangled);
             try {
-                out = cli::run_one(*prepared, opt, python_progress.callback(), result, nullptr);
+                const ProgressFn callback = python_progress.callback();
+                const std::optional<Scene> prepared = cli::prepare_input(
+                    input, "simplify", opt.input_crossings, opt.params, untangled, callback);
+                out = cli::run_one(*prepared, opt, callback, result, nullptr);
             } catch (const Cancelled&) {
                 py::gil_scoped_acquire acquire;
                 python_progress.rethrow_if_any();

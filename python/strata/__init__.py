@@ -196,8 +196,10 @@ def simplify(
       input_crossings: an input that already crosses is untangled first ("untangle",
         default) or refused ("fail": :class:`InvalidInput` naming the first crossing).
       progress: called as progress("simplify", fraction of the removals done) from the
-        computing thread (with the GIL); returning False cancels (:class:`Cancelled`, nothing
-        returned); an exception it raises, or Ctrl-C, stops the work and is raised.
+        computing thread (with the GIL), and as progress("untangle", fraction of its rounds)
+        while an input that crosses is untangled first; returning False cancels
+        (:class:`Cancelled`, nothing returned); an exception it raises, or Ctrl-C, stops the
+        work and is raised.
 
     Raises :class:`InvalidInput` (a parameter out of range, with the CLI's message).
     """

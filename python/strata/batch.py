@@ -112,8 +112,9 @@ def simplify_folder(
     (``tcp://host:8786``) to connect to; else a ``LocalCluster`` of this machine, closed at the
     end. ``report``: also write the CLI's ``--report`` JSON (a list, one entry per slice).
     ``options``: the keyword arguments of :func:`strata.simplify` (same names and defaults),
-    plus ``compare_naive`` (bool) and ``input_crossings="skip"``. They are validated here,
-    before any task runs (:class:`strata.InvalidInput`).
+    plus ``compare_naive`` (bool), ``input_crossings="skip"`` and ``time_limit`` (seconds a
+    slice may take, 0 = none, as ``--time-limit``: past it the slice fails and nothing is
+    written for it). They are validated here, before any task runs (:class:`strata.InvalidInput`).
     """
     from dask.distributed import Client, as_completed
 
@@ -214,6 +215,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     p.add_argument("--thickness", type=float, default=0.0)
     p.add_argument("--input-crossings", default="untangle")
     p.add_argument("--compare-naive", action="store_true")
+    p.add_argument("--time-limit", type=float, default=0.0, help="seconds a slice may take")
     a = p.parse_args(argv)
     from dask.distributed import Client, LocalCluster
 
@@ -225,6 +227,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         thickness=a.thickness,
         input_crossings=a.input_crossings,
         compare_naive=a.compare_naive,
+        time_limit=a.time_limit,
     )
     try:
         if a.scheduler:

@@ -78,9 +78,25 @@ def test_failures_are_reported_per_slice(cli, client, slices_copy, tmp_path):
     assert len(written) == result.slices - 2
 
 
+def test_a_slice_past_the_time_limit_fails_alone(cli, client, slices_copy, tmp_path):
+    # This folded stack takes 29 tries to untangle (about a minute): it stops at the limit.
+    shutil.copy(DATA / "folded_stack_tangled_95.json", slices_copy / "folded.json")
+    code, table = run_cli(cli, [slices_copy], tmp_path / "cli", "--time-limit", "2")
+    result = strata.batch.simplify_folder(slices_copy, tmp_path / "dask", client=client,
+                                          time_limit=2)
+    assert code == result.exit_code == 1
+    assert comparable(result.table) == comparable(table)
+    failed = [r for r in result.rows if r["error"]]
+    assert len(failed) == 1 and "not done within the time limit of 2 s" in failed[0]["error"]
+    written = sorted(p.name for p in (tmp_path / "dask").iterdir())
+    assert "folded.json" not in written and len(written) == result.slices - 1
+
+
 def test_bad_options_are_refused_before_any_task(client, tmp_path):
     with pytest.raises(strata.InvalidInput, match="remove"):
         strata.batch.simplify_folder(SLICES, tmp_path / "out", client=client, remove=2.0)
+    with pytest.raises(strata.InvalidInput, match=r"time_limit must be a number of seconds >= 0"):
+        strata.batch.simplify_folder(SLICES, tmp_path / "out", client=client, time_limit=-1)
     with pytest.raises(TypeError, match="colour"):
         strata.batch.simplify_folder(SLICES, tmp_path / "out", client=client, colour="red")
 

@@ -276,6 +276,23 @@ def test_progress_reports_and_cancels():
         strata.simplify(scene, progress=boom)
 
 
+def test_progress_cancels_the_untangling_of_a_crossing_input():
+    # This folded stack takes 29 tries to untangle (about a minute): the callback stops it in
+    # its first rounds, while the input is untangled, before any removal.
+    scene = strata.read_scene(str(DATA / "folded_stack_tangled_95.json"))
+    seen = []
+
+    def first_rounds(stage, f):
+        seen.append(stage)
+        return len(seen) < 3
+
+    with pytest.raises(strata.Cancelled):
+        strata.simplify(scene, progress=first_rounds)
+    assert seen[0].startswith("untangle") and "simplify" not in seen
+    with pytest.raises(strata.InvalidInput, match="time_limit is for strata.batch"):
+        strata._strata._simplify(scene, dict(time_limit=1.0), None)
+
+
 GARMENTS = DATA.parents[2] / "shared" / "data" / "garments" / "makehuman"
 
 

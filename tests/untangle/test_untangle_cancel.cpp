@@ -53,8 +53,8 @@ std::size_t check_cancelled(const Scene& input, const Run& run) {
 }  // namespace
 
 TEST_CASE("a cancelled untangling leaves the scene as it was", "[untangle]") {
-    // The folded stack at 95% that no try cleans (tests/data/SOURCES.md): every try runs,
-    // failing, and the callback stops each of them somewhere. Fewer passes keep it short.
+    // The folded stack at 95% (tests/data/SOURCES.md) with one pass a try: its tries fail one
+    // after the other, and the callback stops each of them somewhere.
     const Scene input = read_scene(test::test_data("folded_stack_tangled_95.json"));
     UntangleParams params;
     params.give_up_when_stalled = true;
