@@ -9,10 +9,7 @@
 namespace strata::cli {
 
 TimeLimit::TimeLimit(double seconds)
-    : seconds_(seconds),
-      deadline_(std::chrono::steady_clock::now() +
-                std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                    std::chrono::duration<double>(seconds > 0.0 ? seconds : 0.0))) {}
+    : seconds_(seconds), start_(std::chrono::steady_clock::now()) {}
 
 ProgressFn TimeLimit::around(ProgressFn inner) const {
     if (!(seconds_ > 0.0)) return inner;
@@ -23,7 +20,10 @@ ProgressFn TimeLimit::around(ProgressFn inner) const {
 }
 
 bool TimeLimit::is_past() const {
-    return seconds_ > 0.0 && std::chrono::steady_clock::now() >= deadline_;
+    // Compared in double seconds: a huge limit (1e300) never overflows a clock duration.
+    return seconds_ > 0.0 &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count() >=
+               seconds_;
 }
 
 std::string TimeLimit::message(const std::string& input) const {

@@ -36,7 +36,7 @@ class TimeLimit {
 
   private:
     double seconds_ = 0.0;
-    std::chrono::steady_clock::time_point deadline_;
+    std::chrono::steady_clock::time_point start_;
 };
 
 /// Adds `--time-limit SECONDS` (a finite number >= 0; 0, the default: none) bound to `seconds`.
