@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <limits>
@@ -24,6 +25,11 @@ std::string json_report_text(const nlohmann::json& report) {
     return report.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+namespace {
+// A progress bar is drawn on stderr's current line, not yet ended by a newline.
+std::atomic<bool> bar_open{false};
+}  // namespace
+
 ProgressFn terminal_progress() {
     if (!isatty(fileno(stderr))) return {};
     auto last = std::make_shared<std::chrono::steady_clock::time_point>();
@@ -37,9 +43,14 @@ ProgressFn terminal_progress() {
                      stage.data(), filled, "##############################", width - filled, "",
                      static_cast<int>(fraction * 100.0 + 0.5));
         if (fraction >= 1.0) std::fputc('\n', stderr);
+        bar_open = fraction < 1.0;
         std::fflush(stderr);
         return true;
     };
+}
+
+void end_progress_line() {
+    if (bar_open.exchange(false)) std::fputc('\n', stderr);
 }
 
 void check_outputs(const std::vector<std::string>& outputs,

@@ -31,6 +31,10 @@ std::string json_report_text(const nlohmann::json& report);
 /// A progress bar on stderr, drawn only when stderr is a terminal; never cancels.
 ProgressFn terminal_progress();
 
+/// Ends the line of a progress bar that a run left unfinished (it stopped early, or threw), so
+/// that a message printed next starts on a line of its own; nothing when there is none.
+void end_progress_line();
+
 /// Throws InvalidInput when an output would overwrite an input, or its folder is missing.
 void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
 

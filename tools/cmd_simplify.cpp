@@ -245,10 +245,13 @@ Run add_simplify_command(CLI::App& app) {
         std::optional<InputUntangling> untangled;
         const TimeLimit deadline(o.time_limit);
         const ProgressFn progress = deadline.around(terminal_progress());
-        // Stopped at the time limit: nothing written, exit 1 (main()).
+        // Stopped at the time limit: nothing written, exit 1 (main()). A bar left unfinished is
+        // ended before anything else is printed.
         const auto within_limit = [&](auto&& run) {
             try {
-                return run();
+                auto result = run();
+                end_progress_line();
+                return result;
             } catch (const Cancelled&) {
                 if (deadline.is_past()) throw TimeLimitReached(deadline.message(files.front()));
                 throw;

@@ -137,6 +137,7 @@ Run add_untangle_command(CLI::App& app) {
             if (limit.is_past()) throw TimeLimitReached(limit.message(opt->input));
             throw;
         }
+        end_progress_line();
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         // The input's rolled regions were kept, or the original's sides but those read at a

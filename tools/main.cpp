@@ -1,4 +1,5 @@
 // strata: the command-line front end. Each verb lives in its own cmd_*.cpp.
+#include "cli_util.h"
 #include "commands.h"
 #include "time_limit.h"
 
@@ -38,23 +39,29 @@ int main(int argc, char** argv) {
         for (auto& [name, run] : verbs)
             if (app.got_subcommand(name)) return run();
     } catch (const strata::InvalidInput& e) {
+        strata::cli::end_progress_line();
         std::cerr << "strata: error: " << e.what() << '\n';
         return 2;
     } catch (const strata::IoError& e) {
+        strata::cli::end_progress_line();
         std::cerr << "strata: error: " << e.what() << '\n';
         return 2;
     } catch (const strata::Cancelled& e) {
+        strata::cli::end_progress_line();
         std::cerr << "strata: error: " << e.what() << '\n';
         return 1;
     } catch (const strata::cli::TimeLimitReached& e) {
+        strata::cli::end_progress_line();
         std::cerr << "strata: error: " << e.what() << '\n';
         return 1;
     } catch (const std::bad_alloc&) {
+        strata::cli::end_progress_line();
         // Outputs are written atomically (a batch writes each slice's when it is done).
         std::cerr << "strata: error: out of memory: the input needs more memory than this "
                      "process may use (machine or ulimit); no partial output written\n";
         return 1;
     } catch (const std::exception& e) {
+        strata::cli::end_progress_line();
         std::cerr << "strata: error: internal: " << e.what() << '\n';
         return 1;
     }
