@@ -244,7 +244,7 @@ void backends(int repeat) {
                 }
             std::printf(
                 "%-7s %-9s %9.4f %8zu %10.0f %10.3f %8.3f %7.2f %6s %3d/%-3d\n",
-                long_stretch ? "long" : "short", v.name, 0.01 * v.thickness, stats.segments,
+                long_stretch ? "long" : "short", v.name, tangled.layer(0).thickness, stats.segments,
                 static_cast<double>(stats.active_voxels) / static_cast<double>(stats.segments),
                 best[0], best[1], best[1] / best[0], clean ? "yes" : "NO", passes[0], passes[1]);
             std::fflush(stdout);
@@ -415,8 +415,9 @@ int main(int argc, char** argv) {
         if (stretch != "short") paper(400, 1200, repeat, only, margins, backend);
         if (stretch != "long") paper(400, 480, repeat, only, margins, backend);
     } else if (what == "backends") {
-        const int repeat = argc == 4 && std::string(argv[2]) == "--repeat" ? std::atoi(argv[3]) : 3;
-        if (repeat < 1 || (argc != 2 && argc != 4)) {
+        const bool given = argc == 4 && std::string(argv[2]) == "--repeat";
+        const int repeat = given ? std::atoi(argv[3]) : 3;
+        if (repeat < 1 || (argc != 2 && !given)) {
             std::fprintf(stderr, "usage: strata_bench_simplify backends [--repeat N]\n");
             return 2;
         }
