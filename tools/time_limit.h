@@ -24,8 +24,8 @@ class TimeLimit {
     explicit TimeLimit(double seconds);
 
     /// `inner` (possibly empty), but false once the limit is past: the library then stops at
-    /// its next progress call (an untangling round, a batch of removals) and throws Cancelled,
-    /// its input unchanged.
+    /// its next progress call (an untangling round, each percent of a simplification's
+    /// removals) and throws Cancelled, its input unchanged.
     ProgressFn around(ProgressFn inner) const;
 
     /// True when a limit is set and past.
