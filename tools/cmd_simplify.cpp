@@ -247,20 +247,11 @@ Run add_simplify_command(CLI::App& app) {
         const ProgressFn progress = deadline.around(terminal_progress());
         // Stopped at the time limit: nothing written, exit 1 (main()). A bar left unfinished is
         // ended before anything else is printed.
-        const auto within_limit = [&](auto&& run) {
-            try {
-                auto result = run();
-                end_progress_line();
-                return result;
-            } catch (const Cancelled&) {
-                if (deadline.is_past()) throw TimeLimitReached(deadline.message(files.front()));
-                throw;
-            }
-        };
-        const std::optional<Scene> prepared = within_limit([&] {
+        const std::optional<Scene> prepared = deadline.guard(files.front(), [&] {
             return prepare_input(input, files.front(), o.input_crossings, o.params, untangled,
                                  progress);
         });
+        end_progress_line();
         if (!prepared) {
             std::fprintf(stderr,
                          "strata: %s: the input crosses; skipped (--input-crossings skip), "
@@ -280,8 +271,9 @@ Run add_simplify_command(CLI::App& app) {
                       "of the input, as 'strata untangle' does"
                     : "");
         Scene result, naive;
-        const Outcome out =
-            within_limit([&] { return run_one(*prepared, o, progress, result, &naive); });
+        const Outcome out = deadline.guard(
+            files.front(), [&] { return run_one(*prepared, o, progress, result, &naive); });
+        end_progress_line();
         write_scene(result, o.output);
         const SimplifyReport* naive_report = out.naive ? &*out.naive : nullptr;
         if (!o.svg.empty()) {

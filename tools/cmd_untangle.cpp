@@ -129,14 +129,10 @@ Run add_untangle_command(CLI::App& app) {
         // --infer-sides: one untangle().
         const bool fallback = !opt->global_order && !opt->infer_sides;
         const ProgressFn progress = limit.around(terminal_progress());
-        UntangleReport r;
-        try {
-            r = fallback ? untangle_inferring_sides(scene, params, progress, &inferred)
-                         : untangle(scene, params, progress);
-        } catch (const Cancelled&) {
-            if (limit.is_past()) throw TimeLimitReached(limit.message(opt->input));
-            throw;
-        }
+        const UntangleReport r = limit.guard(opt->input, [&] {
+            return fallback ? untangle_inferring_sides(scene, params, progress, &inferred)
+                            : untangle(scene, params, progress);
+        });
         end_progress_line();
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -292,19 +292,21 @@ Outcome simplify_slice(const std::string& input, const std::string& output,
         ensure_not_an_input(o.output, {fs::path(input)});
         const Scene read = with_default_thickness(read_scene(input), opt.thickness);
         const ProgressFn progress = limit.around({});
-        const std::optional<Scene> prepared =
-            prepare_input(read, input, opt.input_crossings, opt.params, o.untangled, progress);
+        // Past the limit: TimeLimitReached, whose message is the slice's error below.
+        const std::optional<Scene> prepared = limit.guard(input, [&] {
+            return prepare_input(read, input, opt.input_crossings, opt.params, o.untangled,
+                                 progress);
+        });
         if (!prepared) {
             o.skipped = true;
             return o;
         }
         Scene result;
-        Outcome r = run_one(*prepared, opt, progress, result, nullptr);
+        Outcome r =
+            limit.guard(input, [&] { return run_one(*prepared, opt, progress, result, nullptr); });
         write_scene(result, o.output);
         o.report = std::move(r.report);
         o.naive = std::move(r.naive);
-    } catch (const Cancelled&) {
-        o.error = limit.is_past() ? limit.message(input) : "cancelled";
     } catch (const std::bad_alloc&) {
         o.error = "out of memory: this slice needs more memory than the process may use";
     } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 /// @file `--time-limit`: how long `strata untangle` may take, or `strata simplify` on one input
 /// (each slice of a batch on its own clock).
 
+#include "strata/core/error.h"
 #include "strata/core/progress.h"
 
 #include <CLI/CLI.hpp>
@@ -33,6 +34,17 @@ class TimeLimit {
 
     /// "IN: not done within the time limit of S s (--time-limit); nothing written".
     std::string message(const std::string& input) const;
+
+    /// run(), whose Cancelled, once the limit is past, becomes TimeLimitReached(message(input)).
+    template <class F>
+    auto guard(const std::string& input, F&& run) const -> decltype(run()) {
+        try {
+            return run();
+        } catch (const Cancelled&) {
+            if (is_past()) throw TimeLimitReached(message(input));
+            throw;
+        }
+    }
 
   private:
     double seconds_ = 0.0;

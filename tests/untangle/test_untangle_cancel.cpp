@@ -7,6 +7,7 @@
 #include "strata/simplify/simplify.h"
 #include "strata/untangle/untangle.h"
 #include "support/fixtures.h"
+#include "support/require.h"
 
 #include <catch2/catch.hpp>
 
@@ -20,13 +21,6 @@ using namespace strata;
 namespace {
 
 using Run = std::function<void(Scene&, const ProgressFn&)>;
-
-bool same_points(const Scene& a, const Scene& b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t l = 0; l < a.size(); ++l)
-        if (a.layer(l).points != b.layer(l).points) return false;
-    return true;
-}
 
 // Runs `run` once to count its progress calls, then again cancelling at call 1, 2, 4, 8, ...
 // and at the last one: every cancelled run throws Cancelled and leaves the scene as it was.
@@ -45,7 +39,7 @@ std::size_t check_cancelled(const Scene& input, const Run& run) {
         const ProgressFn cancel = [&](std::string_view, double) { return ++k < stop; };
         INFO("cancelled at call " << stop << " of " << calls);
         CHECK_THROWS_AS(run(scene, cancel), Cancelled);
-        CHECK(same_points(scene, input));
+        test::require_same_scene(scene, input, true);
     }
     return calls;
 }
