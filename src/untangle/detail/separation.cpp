@@ -50,7 +50,13 @@ class SegmentCells {
         return n < 2 ? 0 : closed_[l] ? n : n - 1;
     }
     Vec2 start(const SegId& s) const { return pts_[s.layer][s.index]; }
-    Vec2 end(const SegId& s) const { return pts_[s.layer][(s.index + 1) % pts_[s.layer].size()]; }
+    Vec2 end(const SegId& s) const { return pts_[s.layer][end_index(s)]; }
+    // The index of the point that ends segment s (no division: this runs in the innermost
+    // loops of the finishing stage).
+    std::size_t end_index(const SegId& s) const {
+        const std::size_t k = s.index + 1;
+        return k == pts_[s.layer].size() ? 0 : k;
+    }
 
     // Vertex (l, v) has moved (pts was updated).
     void moved(std::size_t l, std::size_t v) {
@@ -679,7 +685,9 @@ class Finisher {
         const Box2 box = move_box(l, v, p, to);
         candidates_.clear();
         cells_->query(box, [&](const SegId& s) {
-            if (!is_apart(cells_->start(s), cells_->end(s), box)) candidates_.push_back(s);
+            const std::size_t e = cells_->end_index(s);
+            const Vec2 a = pts_[s.layer][s.index], b = pts_[s.layer][e];
+            if (!is_apart(a, b, box)) candidates_.push_back({s, e, a, b});
         });
     }
 
@@ -698,11 +706,10 @@ class Finisher {
         const std::size_t n = layer_size(l);
         const bool has_prev = closed_[l] || v > 0, has_next = closed_[l] || v + 1 < n;
         const std::size_t prev = (v + n - 1) % n, next = (v + 1) % n;
-        const Box2 box = move_box(l, v, p, to);
-        auto shares_end = [&](const SegId& s, std::size_t a, std::size_t b) {
-            if (s.layer != l) return false;
-            const std::size_t s1 = (s.index + 1) % n;
-            return s.index == a || s.index == b || s1 == a || s1 == b;
+        auto shares_end = [&](const Candidate& c, std::size_t a, std::size_t b) {
+            if (c.id.layer != l) return false;
+            const std::size_t s0 = c.id.index, s1 = c.end_index;
+            return s0 == a || s0 == b || s1 == a || s1 == b;
         };
         auto is_mover = [&](std::size_t m, std::size_t k) {
             return m == l && (k == v || (has_prev && k == prev) || (has_next && k == next));
@@ -717,30 +724,32 @@ class Finisher {
         sweep_next = sweep_prev;
         if (has_prev) sweep_prev.extend(pts_[l][prev]);
         if (has_next) sweep_next.extend(pts_[l][next]);
-        // Whether candidate s refuses the move.
-        auto refuses = [&](const SegId& s) {
-            const Vec2 a = cells_->start(s), b = cells_->end(s);
-            // Everything tested below lies in `box`: the new and old segments and the swept
-            // triangles. A segment whose box is apart from it can neither meet them nor have
-            // an end inside a triangle.
-            if (is_apart(a, b, box)) return false;
-            const bool with_prev = has_prev && !shares_end(s, prev, v);
-            const bool with_next = has_next && !shares_end(s, v, next);
+        // Whether candidate c refuses the move.
+        auto refuses = [&](const Candidate& c) {
+            const Vec2 &a = c.a, &b = c.b;
+            // Everything tested below on the side of `prev` lies in sweep_prev (the old and
+            // new segments and the swept triangle), and likewise for `next`: a segment whose
+            // box is apart from one can neither meet what lies in it nor have an end inside it.
+            const bool near_prev = has_prev && !is_apart(a, b, sweep_prev);
+            const bool near_next = has_next && !is_apart(a, b, sweep_next);
+            if (!near_prev && !near_next) return false;
+            const bool with_prev = near_prev && !shares_end(c, prev, v);
+            const bool with_next = near_next && !shares_end(c, v, next);
             const int now = (with_prev && meets(pts_[l][prev], to, a, b) ? 1 : 0) +
                             (with_next && meets(to, pts_[l][next], a, b) ? 1 : 0);
             // Allowed only as often as the old segments met it.
             if (now > 0 && now > (with_prev && meets(pts_[l][prev], p, a, b) ? 1 : 0) +
                                      (with_next && meets(p, pts_[l][next], a, b) ? 1 : 0))
                 return true;
-            const std::size_t ends[2] = {s.index, (s.index + 1) % layer_size(s.layer)};
+            const std::size_t ends[2] = {c.id.index, c.end_index};
+            const Vec2 at[2] = {a, b};
             for (std::size_t e = 0; e < 2; ++e) {
-                if (is_mover(s.layer, ends[e])) continue;
-                const Vec2 w = pts_[s.layer][ends[e]];
-                if (!box.contains(w)) continue;
-                if (has_prev && sweep_prev.contains(w) &&
+                if (is_mover(c.id.layer, ends[e])) continue;
+                const Vec2& w = at[e];
+                if (near_prev && sweep_prev.contains(w) &&
                     in_closed_triangle(p, to, pts_[l][prev], w))
                     return true;
-                if (has_next && sweep_next.contains(w) &&
+                if (near_next && sweep_next.contains(w) &&
                     in_closed_triangle(p, to, pts_[l][next], w))
                     return true;
             }
@@ -783,7 +792,14 @@ class Finisher {
     std::optional<SegmentCells> cells_;
     std::vector<SegId> active_;  // (layer, vertex) of the vertices near the free ones
     std::vector<SegId> found_;
-    std::vector<SegId> candidates_;  // gather_candidates()
+    // A segment that gather_candidates() found, with the index of its end point and the
+    // positions of its ends (nothing moves while is_safe() tests them).
+    struct Candidate {
+        SegId id;
+        std::size_t end_index;
+        Vec2 a, b;
+    };
+    std::vector<Candidate> candidates_;
     std::vector<double> distance_;  // from the vertex relaxed to each of found_, as found
     double worst_ = 0.0;
     std::size_t wrong_side_ = 0;
