@@ -9,6 +9,8 @@
 #   bench/out_of_sample.sh BUILD WORK [SEEDS...]        default seeds 2 3 4 5 6
 #   REFERENCE=1 bench/out_of_sample.sh BUILD WORK ...   untangle with --reference ORIGINAL too
 #   POINTS=600 bench/out_of_sample.sh BUILD WORK ...    inputs of 600 points a layer
+#   UNTANGLE_ARGS="--backend grid" bench/out_of_sample.sh BUILD WORK ...   more options of
+#                                                       strata untangle (split at spaces)
 #
 # BUILD: a build folder with tools/strata and bench/strata_bench_untangle; WORK: a folder for
 # the inputs and outputs. Prints each dirty case with the untangling's exit code (0: a wrong
@@ -30,6 +32,7 @@ seeds=("$@")
 strata=$build/tools/strata
 mkdir -p "$work/inputs" "$work/out"
 points=${POINTS:-300}
+read -ra untangle_args <<<"${UNTANGLE_ARGS:-}"
 # The inputs are written once per WORK folder; a folder of other points is refused (inputs
 # written before their points were recorded are of 300).
 if [ -e "$work/inputs/stack-naive90.input.json" ]; then
@@ -89,7 +92,8 @@ for f in $families; do
             reference=()
             [ "${REFERENCE:-0}" = 1 ] && reference=(--reference "$original")
             ue=0
-            "$strata" untangle "$t" "${reference[@]}" -o "$u" >/dev/null 2>&1 || ue=$?
+            "$strata" untangle "$t" "${reference[@]}" "${untangle_args[@]}" -o "$u" >/dev/null \
+                2>&1 || ue=$?
             ce=0
             "$strata" check "$u" --reference "$original" --json >"$u.check" 2>/dev/null || ce=$?
             total=$((total + 1))
