@@ -204,6 +204,62 @@ TEST_CASE("the finishing stage never makes a crossing (random stacks)", "[separa
     CHECK(improved > 20);
 }
 
+TEST_CASE("the finishing stage never adds a crossing to a tangled stack", "[separation]") {
+    // Jagged stacks of 4 layers closer than their thickness, some already crossing: every
+    // move is checked before it is made (neither of the vertex's two segments may come to
+    // meet a segment it did not meet, nor sweep over a vertex), so no layer pair and no layer
+    // may end with more crossings than it had.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int tangled = 0, moved = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<Layer> layers;
+        double y0 = 0.0;
+        for (int l = 0; l < 4; ++l) {
+            std::vector<Vec2> points;
+            const int n = 8 + static_cast<int>(16 * u(rng));
+            for (int i = 0; i < n; ++i)
+                points.emplace_back(2.0 * i / (n - 1.0), y0 + 0.08 * (u(rng) - 0.5));
+            points.front().y += 0.5 * (l - 1.5);
+            points.back().y += 0.5 * (l - 1.5);
+            layers.push_back(polyline("l" + std::to_string(l), points, 0.05 + 0.05 * u(rng)));
+            y0 += 0.02 + 0.04 * u(rng);
+        }
+        Scene scene(layers);
+        const CheckReport before = check_scene(scene);
+        tangled += before.crossing_count > 0;
+        INFO("trial " << trial);
+        moved += finish(scene).moves > 0;
+        const CheckReport after = check_scene(scene);
+        REQUIRE(after.crossing_count <= before.crossing_count);
+        REQUIRE(after.total_self_crossings() <= before.total_self_crossings());
+    }
+    CHECK(tangled > 50);
+    CHECK(moved > 100);
+}
+
+TEST_CASE("the finishing stage does not sweep a layer over a small layer", "[separation]") {
+    // The middle layer's vertex 1 is pushed up, away from the bottom layer 0.01 below it (its
+    // thickness asks for 0.15). The top layer, one short fixed segment with no thickness (so
+    // nothing pushes the two apart), lies just above the middle layer, where that push would
+    // sweep the segment (0, 0)-(1, 0) over it without crossing anything: the moves must stop
+    // below it.
+    std::vector<Layer> layers;
+    layers.push_back(polyline("bottom", {{0.0, -0.01}, {1.0, -0.01}, {2.0, -0.01}}, 0.3));
+    layers.push_back(polyline("middle", {{0.0, 0.0}, {1.0, 0.0}, {2.0, 0.0}}, 0.0));
+    layers.push_back(polyline("top", {{0.85, 0.02}, {0.9, 0.03}}, 0.0));
+    Scene scene(layers);
+    REQUIRE(check_scene(scene).crossing_count == 0);
+    REQUIRE(check_scene(scene).nesting_violation_count == 0);
+    finish(scene);
+    const CheckReport after = check_scene(scene);
+    CHECK(after.crossing_count == 0);
+    CHECK(after.nesting_violation_count == 0);
+    // It moved, below the top layer's line through (0, 0).
+    CHECK(scene.layer(1).points[1].y > 0.0);
+    CHECK(scene.layer(1).points[1].y < 0.02 / 0.85);
+}
+
 TEST_CASE("the finishing stage keeps nested loops nested", "[separation]") {
     // Three concentric circles 0.02 apart that must keep 0.05.
     Scene scene = test::nested_circles(3, 48, 1.0, 0.02, 0.05);
