@@ -2,9 +2,9 @@
 /// @file Slicing 3D meshes (garments on a body) by axis-aligned planes into layered 2D scenes,
 /// and inferring the nesting ("a is under b") of the slices. Documented in docs/slicing.md.
 ///
-/// Data flow: read_slice_mesh() (OpenMesh reads OBJ, OFF, PLY, STL) -> SliceMesh (triangles,
-/// double precision) -> section_mesh() (closed loops and open polylines of one
-/// plane) -> nest_layers() (`outer` links) -> Scene. slice_meshes() runs the whole chain for
+/// Data flow: read_slice_mesh() (OBJ, PLY, STL through OpenMesh; OFF read by strata) ->
+/// SliceMesh (triangles, double precision) -> section_mesh() (closed loops and open polylines
+/// of one plane) -> nest_layers() (`outer` links) -> Scene. slice_meshes() runs the whole chain for
 /// several meshes and heights. Lengths are in mesh units (the units of the mesh file).
 
 #include "strata/core/progress.h"

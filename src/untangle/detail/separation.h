@@ -12,9 +12,9 @@
 /// side-by-side layer, a vertex whose run of its layer pokes through
 /// it (bounded by two segments that cross the same segment of it, or by one and an end of
 /// its own open layer) belongs on the side of the rest of its layer. Every move is validated
-/// exactly before it is made: the moved vertex's two new segments meet no other segment and
-/// sweep over no other vertex, so no layer tunnels through another and no crossing is ever
-/// created.
+/// exactly before it is made: the moved vertex's two new segments meet each other segment no
+/// more often than its two old ones did, and the old ones sweep over no other vertex, so no
+/// layer tunnels through another and no crossing is ever added.
 
 #include "untangle/detail/engine.h"
 
