@@ -205,10 +205,10 @@ TEST_CASE("the finishing stage never makes a crossing (random stacks)", "[separa
 }
 
 TEST_CASE("the finishing stage never adds a crossing to a tangled stack", "[separation]") {
-    // Jagged stacks of 4 layers closer than their thickness, some already crossing: every
-    // move is checked before it is made (neither of the vertex's two segments may come to
-    // meet a segment it did not meet, nor sweep over a vertex), so no layer pair and no layer
-    // may end with more crossings than it had.
+    // Jagged stacks of 4 layers closer than their thickness, most already crossing: every
+    // move is checked before it is made (the vertex's two segments may meet each other
+    // segment no more often than before, and sweep over no vertex), so a stack may not end
+    // with more crossings between its layers, or within one, than it had.
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     int tangled = 0, moved = 0;
