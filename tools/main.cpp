@@ -35,35 +35,31 @@ int main(int argc, char** argv) {
         std::cerr << "strata: error: " << e.what() << "\n(run 'strata --help' for usage)\n";
         return 2;
     }
+    // An error after a verb started: a progress bar it left unfinished is ended first, so that
+    // the message has a line of its own. Returns the exit code.
+    auto fail = [](int code, const std::string& message) {
+        strata::cli::end_progress_line();
+        std::cerr << "strata: error: " << message << '\n';
+        return code;
+    };
     try {
         for (auto& [name, run] : verbs)
             if (app.got_subcommand(name)) return run();
     } catch (const strata::InvalidInput& e) {
-        strata::cli::end_progress_line();
-        std::cerr << "strata: error: " << e.what() << '\n';
-        return 2;
+        return fail(2, e.what());
     } catch (const strata::IoError& e) {
-        strata::cli::end_progress_line();
-        std::cerr << "strata: error: " << e.what() << '\n';
-        return 2;
+        return fail(2, e.what());
     } catch (const strata::Cancelled& e) {
-        strata::cli::end_progress_line();
-        std::cerr << "strata: error: " << e.what() << '\n';
-        return 1;
+        return fail(1, e.what());
     } catch (const strata::cli::TimeLimitReached& e) {
-        strata::cli::end_progress_line();
-        std::cerr << "strata: error: " << e.what() << '\n';
-        return 1;
+        return fail(1, e.what());
     } catch (const std::bad_alloc&) {
-        strata::cli::end_progress_line();
         // Outputs are written atomically (a batch writes each slice's when it is done).
-        std::cerr << "strata: error: out of memory: the input needs more memory than this "
-                     "process may use (machine or ulimit); no partial output written\n";
-        return 1;
+        return fail(1,
+                    "out of memory: the input needs more memory than this process may use "
+                    "(machine or ulimit); no partial output written");
     } catch (const std::exception& e) {
-        strata::cli::end_progress_line();
-        std::cerr << "strata: error: internal: " << e.what() << '\n';
-        return 1;
+        return fail(1, std::string("internal: ") + e.what());
     }
     return 2;
 }
