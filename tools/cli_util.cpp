@@ -80,6 +80,18 @@ CLI::Option* add_count_option(CLI::App& cmd, const std::string& name, std::size_
     return cmd.add_option(name, target, help)->check(whole)->capture_default_str();
 }
 
+void add_threads_option(CLI::App& cmd, int& threads) {
+    cmd.add_option("--threads", threads, "Worker threads (0: all cores)")->capture_default_str();
+}
+
+std::unique_ptr<tbb::global_control> thread_limit(const std::string& verb, int threads) {
+    if (threads < 0)
+        throw InvalidInput(verb + ": --threads must be >= 0 (got " + std::to_string(threads) + ")");
+    if (threads == 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                 static_cast<std::size_t>(threads));
+}
+
 void add_backend_option(CLI::App& cmd, FieldBackend& backend) {
     static const std::map<std::string, FieldBackend> names{{"grid", FieldBackend::Grid},
                                                            {"exact", FieldBackend::ExactBrute},

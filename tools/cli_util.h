@@ -6,12 +6,14 @@
 #include "strata/field/field.h"
 #include "strata/geometry/scene.h"
 
+#include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json_fwd.hpp>
 
 #include <cctype>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -64,6 +66,14 @@ CLI::Option* add_choice_option(CLI::App& cmd, const std::string& name, T& target
 /// (got VALUE)"; CLI11's own conversion would wrap "-1" around to 2^64 - 1.
 CLI::Option* add_count_option(CLI::App& cmd, const std::string& name, std::size_t& target,
                               const std::string& help, std::size_t min = 0);
+
+/// Adds `--threads N` bound to `threads` (worker threads, 0: all cores).
+void add_threads_option(CLI::App& cmd, int& threads);
+
+/// The limit that `--threads N` of `verb` sets on TBB's threads, for as long as the returned
+/// object lives; null for 0 (all cores).
+/// @throws InvalidInput when N < 0 ("VERB: --threads must be >= 0 (got N)").
+std::unique_ptr<tbb::global_control> thread_limit(const std::string& verb, int threads);
 
 /// Adds `--backend grid|exact|indexed` bound to `backend`.
 void add_backend_option(CLI::App& cmd, FieldBackend& backend);

@@ -14,7 +14,6 @@
 #include "strata/untangle/untangle.h"
 
 #include <sys/resource.h>
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
@@ -191,8 +190,7 @@ Run add_simplify_command(CLI::App& app) {
                     "Pairs of layers whose thicknesses require nothing keep this share of their "
                     "smallest input gap (0: off)")
         ->capture_default_str();
-    cmd->add_option("--threads", opt->threads, "Worker threads (0: all cores)")
-        ->capture_default_str();
+    add_threads_option(*cmd, opt->threads);
     add_time_limit_option(*cmd, opt->time_limit,
                           "each input (a slice of a batch on its own clock)");
     cmd->add_flag("--global", p.global,
@@ -224,13 +222,7 @@ Run add_simplify_command(CLI::App& app) {
         if (o.no_shape_matching) o.params.untangling.shape = ShapeMode::None;
         if (o.no_finish) o.params.untangling.finish_separations = false;
         validate(o.params);
-        if (o.threads < 0)
-            throw InvalidInput("simplify: --threads must be >= 0 (got " +
-                               std::to_string(o.threads) + ")");
-        std::optional<tbb::global_control> limit;
-        if (o.threads > 0)
-            limit.emplace(tbb::global_control::max_allowed_parallelism,
-                          static_cast<std::size_t>(o.threads));
+        const auto threads = thread_limit("simplify", o.threads);
         if (o.inputs.empty()) return run_demo(o);
         const std::vector<std::string> files = expand_inputs(o.inputs);
         if (files.size() > 1 || fs::is_directory(o.inputs.front())) return run_batch(o, files);

@@ -30,6 +30,7 @@ struct UntangleOptions {
     std::string input, output, svg, report, reference;
     double thickness = 0.0;
     double time_limit = 0.0;  // seconds, 0: none
+    int threads = 0;          // 0: all cores
     bool no_shape_matching = false;
     bool no_finish = false;
     bool infer_sides = false;
@@ -84,6 +85,7 @@ Run add_untangle_command(CLI::App& app) {
     cmd->add_option("--voxel", p.field.voxel_size, "Grid voxel size (scene units; 0 = auto)")
         ->capture_default_str();
     add_time_limit_option(*cmd, opt->time_limit, "the untangling");
+    add_threads_option(*cmd, opt->threads);
     cmd->add_flag("--give-up-when-stalled", p.give_up_when_stalled,
                   "End a try early when its violation, extrapolated, would not fall enough by the "
                   "pass cap");
@@ -97,6 +99,7 @@ Run add_untangle_command(CLI::App& app) {
         if (opt->no_shape_matching) params.shape = ShapeMode::None;
         if (opt->no_finish) params.finish_separations = false;
         validate(params);
+        const auto threads = thread_limit("untangle", opt->threads);
         check_outputs({opt->output, opt->svg, opt->report}, {opt->input, opt->reference});
         scene_format(opt->output);  // reject a bad extension before working
         const Scene input = with_default_thickness(read_scene(opt->input), opt->thickness);
