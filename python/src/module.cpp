@@ -459,9 +459,13 @@ PYBIND11_MODULE(_strata, m) {
         .def_readonly("inferred_sides", &UntangleReport::inferred_sides)
         .def_readonly("gave_up", &UntangleReport::gave_up)
         .def_readonly("input_kept", &UntangleReport::input_kept)
-        .def_property_readonly("seconds", [](const UntangleReport& r) {
-            return r.seconds_fields + r.seconds_untangle + r.seconds_finish + r.seconds_check;
-        });
+        .def_property_readonly(
+            "seconds",
+            [](const UntangleReport& r) {
+                return r.seconds_fields + r.seconds_untangle + r.seconds_finish + r.seconds_check;
+            },
+            "Seconds of the tries, summed: tries after a failed one can run two at a time, so it "
+            "can exceed the call's time");
 
     m.def("_untangle", [](const Scene& scene, const py::dict& kw, const py::object& progress) {
         PythonProgress python_progress{progress, nullptr};

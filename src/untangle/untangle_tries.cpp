@@ -7,6 +7,7 @@
 #include "strata/geometry/input_sides.h"
 #include "strata/geometry/predicates.h"
 #include "untangle/detail/run.h"
+#include "untangle/detail/try_list.h"
 
 #include <glm/geometric.hpp>
 
@@ -73,6 +74,9 @@ struct TriesCost {
 // Each try's counts are those its final check gives (judged by the sides it kept).
 class LeastTangled {
   public:
+    /// `failed`: a try of the call failed before this one was made (any_failed()).
+    explicit LeastTangled(bool failed = false) : failed_(failed) {}
+
     /// Stamped on the reports offered from now on (the retries' flags).
     bool long_rounds = false, retry_passes = false, more_passes = false, loop_reading = false,
          ends_by_nearest = false;
@@ -89,6 +93,7 @@ class LeastTangled {
         report.ends_by_nearest = ends_by_nearest;
         report.inferred_sides = sides != nullptr;
         report.sides_reading = reading;
+        failed_ = true;
         if (!sides && !input_) input_ = as_input(report);
         if (scene_ && !less_tangled(report, report_)) return;
         scene_ = scene;
@@ -121,6 +126,11 @@ class LeastTangled {
         return cost.charged_to(report);
     }
 
+    // Whether a try of the call has failed: from then on, the tries of a list run two at a time
+    // (run_list()); the first try of a call runs alone, since most calls need no other.
+    bool any_failed() const { return failed_; }
+    void mark_failed() { failed_ = true; }
+
   private:
     static bool less_tangled(const UntangleReport& a, const UntangleReport& b) {
         auto key = [](const UntangleReport& r) {
@@ -151,19 +161,55 @@ class LeastTangled {
     UntangleReport report_;
     std::optional<InputSides> sides_;
     std::optional<UntangleReport> input_;
+    bool failed_ = false;
 };
 
-// One untangling of the whole scene; `keep_simple`, `ends_by_nearest`: EngineSettings'. A
-// failed result is offered to `failures` (`sides`, `reading`: LeastTangled::offer()).
+// One try of a whole-scene untangling from a list's input: its params and the other arguments of
+// detail::run_untangling(); `sides`, `reading`: LeastTangled::offer()'s, for a failed result.
+struct TrySpec {
+    const UntangleParams* params = nullptr;
+    bool keep_simple = false;  // EngineSettings::keep_simple
+    const InputSides* sides = nullptr;
+    std::size_t reading = 0;
+    bool ends_by_nearest = false;  // EngineSettings::ends_by_nearest
+};
+
+// The try `spec` on a copy of `input`.
+detail::TryResult one_try(const Scene& input, const TrySpec& spec, const ProgressFn& progress) {
+    detail::TryResult r{input, {}};
+    r.report = detail::run_untangling(r.scene, whole_scene_pieces(r.scene), *spec.params, progress,
+                                      spec.keep_simple, nullptr, spec.ends_by_nearest);
+    r.report.kept_simple = spec.keep_simple;
+    return r;
+}
+
+// One untangling of the whole scene in place (TrySpec's arguments). A failed result is offered
+// to `failures`.
 UntangleReport untangle_once(Scene& scene, const UntangleParams& params, const ProgressFn& progress,
-                             bool keep_simple, LeastTangled& failures,
-                             const InputSides* sides = nullptr, std::size_t reading = 0,
-                             bool ends_by_nearest = false) {
-    UntangleReport report = detail::run_untangling(scene, whole_scene_pieces(scene), params,
-                                                   progress, keep_simple, nullptr, ends_by_nearest);
-    report.kept_simple = keep_simple;
-    if (!report.collision_free) failures.offer(scene, report, sides, reading);
-    return report;
+                             bool keep_simple, LeastTangled& failures) {
+    detail::TryResult r = one_try(scene, TrySpec{&params, keep_simple}, progress);
+    if (!r.report.collision_free) failures.offer(r.scene, r.report, nullptr, 0);
+    scene = std::move(r.scene);
+    return r.report;
+}
+
+// The tries `specs`, each from `input`, by detail::run_try_list(): two at a time once a try of
+// the call has failed (LeastTangled::any_failed()). In order, each failed result is offered to
+// `failures`, every report is added to `cost` (if given), then `take(i, result)` receives the
+// result. With `until_clean` the list ends at the first clean try.
+void run_list(const Scene& input, const std::vector<TrySpec>& specs, bool until_clean,
+              const ProgressFn& progress, LeastTangled& failures, TriesCost* cost,
+              const detail::TakeTry& take) {
+    detail::run_try_list(
+        specs.size(), until_clean, failures.any_failed(),
+        [&](std::size_t i, const ProgressFn& p) { return one_try(input, specs[i], p); },
+        [&](std::size_t i, detail::TryResult&& r) {
+            if (!r.report.collision_free)
+                failures.offer(r.scene, r.report, specs[i].sides, specs[i].reading);
+            if (cost) cost->add(r.report);
+            take(i, std::move(r));
+        },
+        progress);
 }
 
 // a x b for positive counts, at most INT_MAX (a pass cap or a step count a user made large).
@@ -228,13 +274,20 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given, const P
                               LeastTangled& failures) {
     const UntangleParams params = with_outside_sides(scene, given);
     const Scene input = scene;
-    UntangleReport report = untangle_once(scene, params, progress, false, failures);
-    if (report.collision_free) return report;
-    // Second try, from the input: no vertex move that makes a self-crossing (the projection
-    // and shape matching make them, and nothing takes them out: docs/untangle.md).
-    Scene simple = input;
-    const UntangleReport second = untangle_once(simple, params, progress, true, failures);
-    return after_retry(scene, report, std::move(simple), second);
+    // The first try, then a second from the input: no vertex move that makes a self-crossing
+    // (the projection and shape matching make them, and nothing takes them out:
+    // docs/untangle.md). The first result is kept unless the second is clean.
+    std::vector<UntangleReport> reports;
+    run_list(input, {TrySpec{&params, false}, TrySpec{&params, true}}, true, progress, failures,
+             nullptr, [&](std::size_t i, detail::TryResult&& r) {
+                 if (i == 0 || r.report.collision_free) scene = std::move(r.scene);
+                 reports.push_back(r.report);
+             });
+    if (reports.size() == 1) return reports[0];
+    TriesCost cost;
+    cost.add(reports[0]);
+    cost.add(reports[1]);
+    return cost.charged_to(reports[1].collision_free ? reports[1] : reports[0]);
 }
 
 UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
@@ -256,35 +309,31 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     // costs what it did without them.
     const Scene input = scene;
     TriesCost cost;
-    // One try from the input into `attempt`; true when it comes out clean. `sides`, `reading`:
-    // what p.input_sides are when not params' (LeastTangled::offer()).
-    auto clean_try = [&](const UntangleParams& p, bool keep_simple, Scene& attempt,
-                         UntangleReport& report, const InputSides* sides, std::size_t reading) {
-        attempt = input;
-        report = untangle_once(attempt, p, progress, keep_simple, failures, sides, reading);
-        cost.add(report);
-        return report.collision_free;
-    };
     // The first clean try of `order` (by the inferred sides or by the global order), the
-    // first tries of the order before its second ones: `scene` becomes its result, and the
-    // report counts every try so far; nullopt when none is clean.
+    // first tries of the order before its second ones, each from the input: `scene` becomes
+    // its result, and the report counts every try so far; nullopt when none is clean.
     // `by_sides`: the params of the tries by the inferred sides.
     auto first_clean = [&](std::initializer_list<bool> order,
                            const UntangleParams& by_sides) -> std::optional<UntangleReport> {
+        std::vector<TrySpec> specs;
+        std::vector<bool> by_inferred;
         for (bool keep_simple : {false, true})
-            for (bool by_inferred : order) {
-                Scene attempt;
-                UntangleReport report;
-                const bool clean =
-                    by_inferred ? clean_try(by_sides, keep_simple, attempt, report, &inferred, 0)
-                                : clean_try(global, keep_simple, attempt, report, nullptr, 0);
-                if (!clean) continue;
-                report.inferred_sides = by_inferred;
-                if (by_inferred && kept) *kept = std::move(inferred);
-                scene = std::move(attempt);
-                return cost.charged_to(report);
+            for (bool inferred_try : order) {
+                specs.push_back(inferred_try ? TrySpec{&by_sides, keep_simple, &inferred}
+                                             : TrySpec{&global, keep_simple});
+                by_inferred.push_back(inferred_try);
             }
-        return std::nullopt;
+        std::optional<UntangleReport> done;
+        run_list(input, specs, true, progress, failures, &cost,
+                 [&](std::size_t i, detail::TryResult&& r) {
+                     if (!r.report.collision_free) return;
+                     r.report.inferred_sides = by_inferred[i];
+                     scene = std::move(r.scene);
+                     done = cost.charged_to(r.report);
+                 });
+        // Once no try reads the inferred sides any more.
+        if (done && done->inferred_sides && kept) *kept = std::move(inferred);
+        return done;
     };
     // Without rolled regions the inferred sides are the global order's, but for the vertices
     // they give no side (around an end of the other layer, a tie): there only the distance
@@ -312,23 +361,28 @@ UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,
     if (params.other_readings > 0)
         others = recorded.region_alternatives(scene, global.outside_sides);
     if (others.size() > params.other_readings) others.resize(params.other_readings);
+    std::vector<UntangleParams> by_other(others.size(), global);
+    for (std::size_t i = 0; i < others.size(); ++i) {
+        by_other[i].input_sides = &others[i];
+        by_other[i].open_cut_bends = false;
+    }
     for (bool keep_simple : {false, true}) {
+        std::vector<TrySpec> specs;
+        for (std::size_t i = 0; i < others.size(); ++i)
+            specs.push_back(TrySpec{&by_other[i], keep_simple, &others[i], i + 1});
         std::size_t best = others.size();
         Scene best_scene;
         UntangleReport best_report;
-        for (std::size_t i = 0; i < others.size(); ++i) {
-            UntangleParams p = global;
-            p.input_sides = &others[i];
-            p.open_cut_bends = false;
-            Scene attempt;
-            UntangleReport report;
-            if (!clean_try(p, keep_simple, attempt, report, &others[i], i + 1) ||
-                (best < others.size() && report.max_displacement >= best_report.max_displacement))
-                continue;
-            best = i;
-            best_scene = std::move(attempt);
-            best_report = report;
-        }
+        run_list(input, specs, false, progress, failures, &cost,
+                 [&](std::size_t i, detail::TryResult&& r) {
+                     if (!r.report.collision_free ||
+                         (best < others.size() &&
+                          r.report.max_displacement >= best_report.max_displacement))
+                         return;
+                     best = i;
+                     best_scene = std::move(r.scene);
+                     best_report = r.report;
+                 });
         if (best == others.size()) continue;
         best_report.inferred_sides = true;
         best_report.sides_reading = best + 1;
@@ -496,7 +550,7 @@ UntangleReport restarted_tries(Scene& scene, const Scene& input, const UntangleP
                                const UntangleReport& failed, const ProgressFn& progress) {
     UntangleReport report =
         from_least_tangled(scene, input, failed, [&](Scene& s) -> std::optional<UntangleReport> {
-            LeastTangled not_kept;  // a failed restart keeps the result it started from
+            LeastTangled not_kept(true);  // a failed restart keeps the result it started from
             return given_sides_tries(s, p, progress, not_kept);
         });
     report.restarted = report.collision_free;
@@ -581,19 +635,17 @@ UntangleReport with_ends_by_nearest(Scene& scene, const Scene& input, const Unta
     cost.add(failed);
     failures.long_rounds = failures.retry_passes = failures.more_passes = false;
     failures.ends_by_nearest = true;
-    for (bool keep_simple : {false, true}) {
-        Scene attempt = input;
-        UntangleReport report =
-            untangle_once(attempt, params, progress, keep_simple, failures, nullptr, 0, true);
-        cost.add(report);
-        if (!report.collision_free) continue;
-        report.ends_by_nearest = true;
-        failures.ends_by_nearest = false;
-        scene = std::move(attempt);
-        return cost.charged_to(report);
-    }
+    std::optional<UntangleReport> done;
+    run_list(input,
+             {TrySpec{&params, false, nullptr, 0, true}, TrySpec{&params, true, nullptr, 0, true}},
+             true, progress, failures, &cost, [&](std::size_t, detail::TryResult&& r) {
+                 if (!r.report.collision_free) return;
+                 r.report.ends_by_nearest = true;
+                 scene = std::move(r.scene);
+                 done = cost.charged_to(r.report);
+             });
     failures.ends_by_nearest = false;
-    return cost.charged_to(failed);
+    return done ? *done : cost.charged_to(failed);
 }
 
 // Vertex sides of `scene` that `every` gives and `kept` leaves out (once per other layer).
@@ -649,6 +701,7 @@ UntangleReport original_sides_tries(Scene& scene, const UntangleParams& params,
         if (kept) *kept = std::move(fewer);
         return first;
     }
+    failures.mark_failed();
     UntangleReport second = given_sides_tries(scene, params, progress, failures);
     TriesCost cost;
     cost.add(first);
@@ -672,24 +725,28 @@ UntangleReport loop_readings_tries(Scene& scene, const Scene& input, const Untan
     cost.add(failed);
     failures.long_rounds = failures.retry_passes = failures.more_passes = false;
     failures.loop_reading = true;
+    std::vector<UntangleParams> by_reading(readings.size(), global);
+    std::vector<TrySpec> specs;
+    for (std::size_t i = 0; i < readings.size(); ++i) {
+        by_reading[i].input_sides = &readings[i];
+        by_reading[i].open_cut_bends = false;  // inferred sides: a cut bend is in question
+    }
     for (bool keep_simple : {false, true})
-        for (std::size_t i = 0; i < readings.size(); ++i) {
-            UntangleParams p = global;
-            p.input_sides = &readings[i];
-            p.open_cut_bends = false;  // inferred sides: a cut bend is what is in question
-            Scene attempt = input;
-            UntangleReport report =
-                untangle_once(attempt, p, progress, keep_simple, failures, &readings[i], i + 1);
-            cost.add(report);
-            if (!report.collision_free) continue;
-            report.inferred_sides = true;
-            report.sides_reading = i + 1;
-            report.loop_reading = true;
-            if (kept) *kept = std::move(readings[i]);
-            scene = std::move(attempt);
-            return cost.charged_to(report);
-        }
-    return cost.charged_to(failed);
+        for (std::size_t i = 0; i < readings.size(); ++i)
+            specs.push_back(TrySpec{&by_reading[i], keep_simple, &readings[i], i + 1});
+    std::optional<UntangleReport> done;
+    run_list(input, specs, true, progress, failures, &cost,
+             [&](std::size_t j, detail::TryResult&& r) {
+                 if (!r.report.collision_free) return;
+                 r.report.inferred_sides = true;
+                 r.report.sides_reading = j % readings.size() + 1;
+                 r.report.loop_reading = true;
+                 scene = std::move(r.scene);
+                 done = cost.charged_to(r.report);
+             });
+    if (!done) return cost.charged_to(failed);
+    if (kept) *kept = std::move(readings[done->sides_reading - 1]);  // no try reads it now
+    return *done;
 }
 
 UntangleReport inferring_sides_and_retries(Scene& scene, const UntangleParams& params,

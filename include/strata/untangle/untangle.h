@@ -305,7 +305,15 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// tries once more from that result (params.restart), each kept when clean. When every try
 /// fails, the result is the least tangled of all their results and the input, as untangle()
 /// orders them, each try judged by the sides it untangled toward (report.inferred_sides and
-/// sides_reading say which). Same params, progress and throws as untangle(). `kept`: if given,
+/// sides_reading say which). Once a try has failed, the tries of a list that all start from
+/// the same input (first and second tries, the inferred sides and the global order, the other
+/// readings, the ends read by the nearest feature, the loop readings) run two at a time where a
+/// TBB worker thread is idle (none with tbb::global_control's max_allowed_parallelism at 1):
+/// the result, the report and the progress calls are those of one try at a time, but the
+/// seconds, summed over the tries, can exceed the call's time. `progress` is called from the
+/// calling thread only, the calls of one try after another's; a try started ahead that is not
+/// needed (an earlier one came out clean) is stopped, and neither counts nor is seen.
+/// Same params, progress and throws as untangle(). `kept`: if given,
 /// receives the inferred sides when they were kept (a clean result's, or a failed one's), for
 /// judging the result (check_scene() with them and params' outside sides, or outside_sides() of
 /// the input); left alone otherwise.
