@@ -22,9 +22,9 @@ struct TryResult {
     UntangleReport report;
 };
 
-/// Try i of a list. `progress` is the caller's when the try runs on the calling thread;
-/// elsewhere it only says (false) when the try is no longer wanted. Must be safe to call from
-/// two threads at once.
+/// Try i of a list. `progress` queues the try's calls for the caller's progress and returns
+/// false once the try is no longer wanted (or the caller cancelled). Must be safe to call
+/// from two threads at once.
 using RunTry = std::function<TryResult(std::size_t i, const ProgressFn& progress)>;
 
 /// Receives the result of try i, on the calling thread, in the order of i. It must not change
@@ -39,8 +39,9 @@ using TakeTry = std::function<void(std::size_t i, TryResult&& result)>;
 /// the calling thread runs one: two at a time, none where the workers are busy or the
 /// parallelism is limited to one thread. A try started ahead that the list no longer needs
 /// (a clean one came before it) stops at its next progress call and is not taken.
-/// `progress` is called from the calling thread only (with the stage and fraction of the try
-/// it waits for); when it returns false, every try stops and Cancelled is thrown.
+/// `progress` is called from the calling thread only, with the calls of the tries taken in the
+/// order of the tries (those of one try at a time, as when they run one at a time); when it
+/// returns false, every try stops and Cancelled is thrown.
 /// @throws Cancelled; what a taken try throws, once the other try has stopped.
 std::size_t run_try_list(std::size_t count, bool until_clean, bool ahead, const RunTry& run,
                          const TakeTry& take, const ProgressFn& progress);
