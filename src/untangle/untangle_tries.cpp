@@ -277,17 +277,19 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given, const P
     // The first try, then a second from the input: no vertex move that makes a self-crossing
     // (the projection and shape matching make them, and nothing takes them out:
     // docs/untangle.md). The first result is kept unless the second is clean.
-    std::vector<UntangleReport> reports;
+    UntangleReport first;
+    std::optional<detail::TryResult> second;
     run_list(input, {TrySpec{&params, false}, TrySpec{&params, true}}, true, progress, failures,
              nullptr, [&](std::size_t i, detail::TryResult&& r) {
-                 if (i == 0 || r.report.collision_free) scene = std::move(r.scene);
-                 reports.push_back(r.report);
+                 if (i > 0) {
+                     second = std::move(r);
+                     return;
+                 }
+                 first = r.report;
+                 scene = std::move(r.scene);
              });
-    if (reports.size() == 1) return reports[0];
-    TriesCost cost;
-    cost.add(reports[0]);
-    cost.add(reports[1]);
-    return cost.charged_to(reports[1].collision_free ? reports[1] : reports[0]);
+    if (!second) return first;
+    return after_retry(scene, first, std::move(second->scene), second->report);
 }
 
 UntangleReport inferring_sides_tries(Scene& scene, const UntangleParams& params,

@@ -43,14 +43,14 @@ class TryList {
     // claimed by the worker, which the calling thread then waits for before it returns.
     std::size_t claim(bool worker) {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (stop_ || next_ >= slots_.size() || next_ > last_) return none;
+        if (!claimable()) return none;
         if (worker) worker_busy_ = true;
         return next_++;
     }
 
     bool has_unclaimed() {
         std::lock_guard<std::mutex> lock(mutex_);
-        return !stop_ && next_ < slots_.size() && next_ <= last_;
+        return claimable();
     }
 
     // The worker's loop: claims and runs tries until none is left.
@@ -153,6 +153,9 @@ class TryList {
     };
 
     bool wanted(std::size_t i) const { return !stop_ && i <= last_; }
+
+    // Whether try next_ is left to run and may be needed (under mutex_).
+    bool claimable() const { return next_ < slots_.size() && wanted(next_); }
 
     void queue(std::size_t i, std::string_view stage, double fraction) {
         {
