@@ -107,7 +107,7 @@ class UniformGrid {
                     if (in_dense(i, j))
                         f(dense_index(i, j));
                     else if (first_pass)
-                        hashed_[key(i, j)].push_back(id);
+                        hashed_cell(key(i, j)).push_back(id);
                 }
         };
         for (const Id& id : ids) each_dense_cell(id, true, [&](std::size_t k) { ++start_[k + 1]; });
@@ -219,8 +219,18 @@ class UniformGrid {
         std::size_t looked_up = 0;
         auto visit = [&](long long i, long long j) {
             ++looked_up;
-            const Items v = find(i, j);
-            if (!v.empty()) offer_cell(i, j, v);
+            // A cell farther than the best so far is not looked up (offer_cell() would skip
+            // it): the lookups, not the offers, are most of a search through empty cells.
+            if (!(best2 < std::numeric_limits<double>::infinity())) {
+                if (const Items v = find(i, j); !v.empty()) offer_cell(i, j, v);
+                return;
+            }
+            const double lo_x = o.x + static_cast<double>(i) * h - slack;
+            const double lo_y = o.y + static_cast<double>(j) * h - slack;
+            const double dx = std::max({lo_x - x.x, 0.0, x.x - (lo_x + h + 2.0 * slack)});
+            const double dy = std::max({lo_y - x.y, 0.0, x.y - (lo_y + h + 2.0 * slack)});
+            if (dx * dx + dy * dy > best2) return;
+            if (const Items v = find(i, j); !v.empty()) offer_cell(i, j, v);
         };
         const long long ci = column(x.x), cj = row(x.y);
         const long long start = std::max({imin_ - ci, ci - imax_, jmin_ - cj, cj - jmax_, 0LL});
@@ -305,10 +315,10 @@ class UniformGrid {
 
     /// Cells, their item lists and the hash table's nodes and bucket array, in bytes.
     std::size_t memory_bytes() const {
-        std::size_t bytes = dense_.capacity() * sizeof(std::vector<Id>) +
-                            start_.capacity() * sizeof(std::size_t) +
-                            packed_ids_.capacity() * sizeof(Id) +
-                            hashed_.bucket_count() * sizeof(void*) + large_.capacity() * sizeof(Id);
+        std::size_t bytes =
+            dense_.capacity() * sizeof(std::vector<Id>) + start_.capacity() * sizeof(std::size_t) +
+            packed_ids_.capacity() * sizeof(Id) + hashed_.bucket_count() * sizeof(void*) +
+            large_.capacity() * sizeof(Id) + filter_.capacity() * sizeof(std::uint64_t);
         for (const auto& c : dense_) bytes += c.capacity() * sizeof(Id);
         // One node per hashed cell: key, list and the node's next pointer.
         for (const auto& [key, ids] : hashed_)
@@ -398,7 +408,45 @@ class UniformGrid {
     }
     std::vector<Id>& slot(long long i, long long j) {
         if (in_dense(i, j)) return dense_[dense_index(i, j)];
-        return hashed_[key(i, j)];
+        return hashed_cell(key(i, j));
+    }
+    // The hashed cell `k`, made (and marked in filter_) if new.
+    std::vector<Id>& hashed_cell(std::uint64_t k) {
+        const auto [it, made] = hashed_.try_emplace(k);
+        if (made) {
+            if (hashed_.size() * kFilterBitsPerCell > filter_.size() * 64) grow_filter();
+            mark(k);
+        }
+        return it->second;
+    }
+    // filter_: one bit per hash of a cell key, set for every key in hashed_ (a cell emptied
+    // keeps its bit, as it keeps its entry). A clear bit says that a cell is not hashed
+    // without a lookup in hashed_, whose division by its bucket count (and one per node of
+    // the bucket) made most of the cost of a nearest search through empty hashed cells.
+    static constexpr std::size_t kFilterBitsPerCell = 16;
+    std::size_t filter_bit(std::uint64_t k) const {
+        return static_cast<std::size_t>((k * 0x9E3779B97F4A7C15ull) >> filter_shift_);
+    }
+    void mark(std::uint64_t k) {
+        const std::size_t b = filter_bit(k);
+        filter_[b >> 6] |= std::uint64_t{1} << (b & 63);
+    }
+    bool may_be_hashed(std::uint64_t k) const {
+        const std::size_t b = filter_bit(k);
+        return (filter_[b >> 6] >> (b & 63)) & 1u;
+    }
+    // Makes filter_ the smallest power of two of at least 4,096 bits with kFilterBitsPerCell
+    // bits a hashed cell, and marks every key again.
+    void grow_filter() {
+        std::size_t bits = 4096;
+        int shift = 64 - 12;
+        while (bits < hashed_.size() * kFilterBitsPerCell) {
+            bits *= 2;
+            --shift;
+        }
+        filter_.assign(bits / 64, 0);
+        filter_shift_ = shift;
+        for (const auto& cell : hashed_) mark(cell.first);
     }
     Items dense_items(std::size_t k) const {
         if (packed_) return {packed_ids_.data() + start_[k], packed_ids_.data() + start_[k + 1]};
@@ -408,7 +456,9 @@ class UniformGrid {
     Items find(long long i, long long j) const {
         if (in_dense(i, j)) return dense_items(dense_index(i, j));
         if (hashed_.empty()) return {};
-        const auto it = hashed_.find(key(i, j));
+        const std::uint64_t k = key(i, j);
+        if (!may_be_hashed(k)) return {};
+        const auto it = hashed_.find(k);
         if (it == hashed_.end()) return {};
         return {it->second.data(), it->second.data() + it->second.size()};
     }
@@ -425,6 +475,8 @@ class UniformGrid {
     std::vector<std::size_t> start_;  // packed: cell k's items are [start_[k], start_[k+1])
     std::vector<Id> packed_ids_;
     std::unordered_map<std::uint64_t, std::vector<Id>> hashed_;  // the cells outside it
+    std::vector<std::uint64_t> filter_;  // see hashed_cell(): empty while hashed_ is
+    int filter_shift_ = 64;              // filter_bit(): the top 64 - filter_shift_ bits
     std::vector<Id> large_;                                      // items of too many cells
     // Range of the cells occupied since the last clear() (erase() does not shrink it).
     long long imin_ = std::numeric_limits<long long>::max();
