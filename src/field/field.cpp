@@ -90,7 +90,13 @@ ResolvedFieldParams resolve(const FieldParams& params, const Scene& scene) {
             std::max(thickness + penetration + params.band_margin_voxels * out.voxel_size,
                      3.0 * out.voxel_size);
     }
-    out.bucket_size = params.bucket_size > 0.0 ? params.bucket_size : 2.0 * median;
+    // A bucket about as wide as the band: sample_in_band() searches the band around a point,
+    // and a search over many buckets finer than it costs more than the segments it offers.
+    // At least 2 median segments (the nearest of a layer's own segment), at most 8 (the
+    // segments a bucket holds).
+    out.bucket_size = params.bucket_size > 0.0
+                          ? params.bucket_size
+                          : std::max(2.0 * median, std::min(out.band_width, 8.0 * median));
     out.region = params.region;
     return out;
 }

@@ -261,7 +261,13 @@ TEST_CASE("validate and resolve FieldParams", "[field]") {
     const double seg = 2.0 * 1.25 * std::sin(kPi / 100.0);
     CHECK(r.voxel_size == Approx(0.25 * seg));
     CHECK(r.band_width == Approx(2.0 * seg + 2.0 * r.voxel_size));
-    CHECK(r.bucket_size == Approx(2.0 * seg));
+    CHECK(r.bucket_size == Approx(r.band_width));  // the band, within 2-8 median segments
+    FieldParams narrow;
+    narrow.band_width = 0.5 * seg;
+    CHECK(resolve(narrow, circles).bucket_size == Approx(2.0 * seg));
+    FieldParams wide;
+    wide.band_width = 100.0 * seg;
+    CHECK(resolve(wide, circles).bucket_size == Approx(8.0 * seg));
     FieldParams tight;
     tight.voxel_size = 0.0;
     const Scene thin = test::nested_circles(2, 100, 1.0, 0.25, 0.004);
