@@ -90,13 +90,16 @@ ResolvedFieldParams resolve(const FieldParams& params, const Scene& scene) {
             std::max(thickness + penetration + params.band_margin_voxels * out.voxel_size,
                      3.0 * out.voxel_size);
     }
-    // A bucket about as wide as the band: sample_in_band() searches the band around a point,
-    // and a search over many buckets finer than it costs more than the segments it offers.
-    // At least 2 median segments (the nearest of a layer's own segment), at most 8 (the
-    // segments a bucket holds).
-    out.bucket_size = params.bucket_size > 0.0
-                          ? params.bucket_size
-                          : std::max(2.0 * median, std::min(out.band_width, 8.0 * median));
+    // ExactIndexed: a bucket about as wide as the band. sample_in_band() searches the band
+    // around a point, and a search over many buckets finer than it costs more than the
+    // segments it offers. At least 2 median segments (the nearest of a layer's own segment),
+    // at most 8 (the segments a bucket holds). The Grid backend's own index (its voxel values,
+    // searched next to the segments) keeps 2 median segments.
+    out.bucket_size = params.bucket_size;
+    if (out.bucket_size == 0.0)
+        out.bucket_size = params.backend == FieldBackend::Grid
+                              ? 2.0 * median
+                              : std::max(2.0 * median, std::min(out.band_width, 8.0 * median));
     out.region = params.region;
     return out;
 }

@@ -261,11 +261,15 @@ TEST_CASE("validate and resolve FieldParams", "[field]") {
     const double seg = 2.0 * 1.25 * std::sin(kPi / 100.0);
     CHECK(r.voxel_size == Approx(0.25 * seg));
     CHECK(r.band_width == Approx(2.0 * seg + 2.0 * r.voxel_size));
-    CHECK(r.bucket_size == Approx(r.band_width));  // the band, within 2-8 median segments
-    FieldParams narrow;
+    CHECK(r.bucket_size == Approx(2.0 * seg));  // the grid's own index
+    // ExactIndexed: the band, within 2-8 median segments.
+    FieldParams indexed;
+    indexed.backend = FieldBackend::ExactIndexed;
+    CHECK(resolve(indexed, circles).bucket_size == Approx(r.band_width));
+    FieldParams narrow = indexed;
     narrow.band_width = 0.5 * seg;
     CHECK(resolve(narrow, circles).bucket_size == Approx(2.0 * seg));
-    FieldParams wide;
+    FieldParams wide = indexed;
     wide.band_width = 100.0 * seg;
     CHECK(resolve(wide, circles).bucket_size == Approx(8.0 * seg));
     FieldParams tight;

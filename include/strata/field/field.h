@@ -68,9 +68,10 @@ struct FieldParams {
     double expected_penetration = 0.0;
     /// Extra voxels of band for the bilinear interpolation, >= 0.
     double band_margin_voxels = 2.0;
-    /// Bucket size of the ExactIndexed backend, scene units, >= 0. 0 = automatic: the band
-    /// width, but at least twice and at most 8 times the median segment length. Speed only:
-    /// the samples are exact whatever the size.
+    /// Bucket size of the segment index, scene units, >= 0. 0 = automatic: for ExactIndexed
+    /// the band width, but at least twice and at most 8 times the median segment length; for
+    /// Grid (the index its voxel values are computed from) twice the median segment length.
+    /// Speed only: the samples do not depend on it.
     double bucket_size = 0.0;
     /// Grid backend: where the caller will sample, scene units (empty, the default: anywhere).
     /// The grid is then built and updated only within `region` grown by the band width, so a
