@@ -207,30 +207,27 @@ class UniformGrid {
         // Rounding slack of the cell corners (origin + i h) against column() / row().
         const double slack =
             1e-9 * (h + std::abs(x.x) + std::abs(x.y) + std::abs(o.x) + std::abs(o.y));
-        auto offer_cell = [&](long long i, long long j, const Items& v) {
+        // Squared distance from x to cell (i, j), grown by the slack.
+        auto cell_distance2 = [&](long long i, long long j) {
             const double lo_x = o.x + static_cast<double>(i) * h - slack;
             const double lo_y = o.y + static_cast<double>(j) * h - slack;
             const double dx = std::max({lo_x - x.x, 0.0, x.x - (lo_x + h + 2.0 * slack)});
             const double dy = std::max({lo_y - x.y, 0.0, x.y - (lo_y + h + 2.0 * slack)});
-            if (dx * dx + dy * dy > best2) return;
+            return dx * dx + dy * dy;
+        };
+        auto offer_cell = [&](long long i, long long j, const Items& v) {
+            if (cell_distance2(i, j) > best2) return;
             for (const Id& id : v) best2 = offer(id);
         };
         const std::size_t budget = dense_cells() + hashed_.size() + 16;
         std::size_t looked_up = 0;
         auto visit = [&](long long i, long long j) {
             ++looked_up;
-            // A cell farther than the best so far is not looked up (offer_cell() would skip
-            // it): the lookups, not the offers, are most of a search through empty cells.
-            if (!(best2 < std::numeric_limits<double>::infinity())) {
-                if (const Items v = find(i, j); !v.empty()) offer_cell(i, j, v);
-                return;
-            }
-            const double lo_x = o.x + static_cast<double>(i) * h - slack;
-            const double lo_y = o.y + static_cast<double>(j) * h - slack;
-            const double dx = std::max({lo_x - x.x, 0.0, x.x - (lo_x + h + 2.0 * slack)});
-            const double dy = std::max({lo_y - x.y, 0.0, x.y - (lo_y + h + 2.0 * slack)});
-            if (dx * dx + dy * dy > best2) return;
-            if (const Items v = find(i, j); !v.empty()) offer_cell(i, j, v);
+            // A cell farther than the best so far is not even looked up: the lookups, not the
+            // offers, are most of a search through empty cells.
+            if (cell_distance2(i, j) > best2) return;
+            if (const Items v = find(i, j); !v.empty())
+                for (const Id& id : v) best2 = offer(id);
         };
         const long long ci = column(x.x), cj = row(x.y);
         const long long start = std::max({imin_ - ci, ci - imax_, jmin_ - cj, cj - jmax_, 0LL});
