@@ -161,14 +161,19 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     // The last run of the finishing stage left a close vertex on the wrong side of another
     // layer (true when the stage is off: nothing tells).
     bool wrong_side = true;
+    // The last finish_and_check() moved nothing (the stage made no move, or undid them all),
+    // and nothing has moved since: calling it again would give the same result.
+    bool idle_since_finish = false;
     FinishCache finish_cache;  // the same work scene and pieces at every call
     auto finish_and_check = [&](bool only_when_untangled) {
+        idle_since_finish = true;
         if (params.finish_separations) {
             const auto begin = Clock::now();
             finish.only_when_untangled = only_when_untangled;
             const SeparationResult f =
                 finish_separations(work, pieces, relations, finish, &finish_cache);
             wrong_side = f.wrong_side > 0;
+            idle_since_finish = f.moves == 0;
             ++result.finishes;
             result.finish_moves += f.moves;
             result.seconds_finish += seconds_since(begin);
@@ -259,13 +264,16 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
         if (!settings.rest_at_start) rest = shapes_of(work, pieces);
         for (int round = 0; round < params.max_rounds; ++round) {
             const bool match = settings.rest_at_start ? pass > 0 || round > 0 : round > 0;
-            if (match && params.shape == ShapeMode::ShapeMatching)
+            if (match && params.shape == ShapeMode::ShapeMatching) {
                 engine.match_shapes(work, pieces, rest);
+                idle_since_finish = false;
+            }
             // V (Eq. 7) of the round's last projection step: shape matching moves the
             // vertices at the start of every round, the projection must settle them again.
             double moved = 0.0;
             for (int s = 0; s < params.gradient_steps && !result.ok; ++s) {
                 moved = engine.project(work, pieces);
+                idle_since_finish = false;
                 if (settings.check_every_step && s + 1 < params.gradient_steps) {
                     result.seconds_untangle += seconds_since(start);
                     finish_and_check(true);
@@ -300,7 +308,9 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
             if (result.ok) break;
         }
         result.seconds_untangle += seconds_since(start);
-        if (!result.ok) finish_and_check(false);
+        // A pass whose last round ended with a finishing run that moved nothing (often one
+        // that undid its moves) would repeat that run on the same scene.
+        if (!result.ok && !idle_since_finish) finish_and_check(false);
     }
     return result;
 }
