@@ -161,19 +161,20 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
     // The last run of the finishing stage left a close vertex on the wrong side of another
     // layer (true when the stage is off: nothing tells).
     bool wrong_side = true;
-    // The last finish_and_check() moved nothing (the stage made no move, or undid them all),
-    // and nothing has moved since: calling it again would give the same result.
+    // The last finish_and_check() moved nothing (the stage made no move, or undid them all)
+    // and was not limited to untangled scenes, and nothing has moved since: calling
+    // finish_and_check(false) again would give the same result.
     bool idle_since_finish = false;
     FinishCache finish_cache;  // the same work scene and pieces at every call
     auto finish_and_check = [&](bool only_when_untangled) {
-        idle_since_finish = true;
+        idle_since_finish = true;  // the stage off: the check alone, on the same scene
         if (params.finish_separations) {
             const auto begin = Clock::now();
             finish.only_when_untangled = only_when_untangled;
             const SeparationResult f =
                 finish_separations(work, pieces, relations, finish, &finish_cache);
             wrong_side = f.wrong_side > 0;
-            idle_since_finish = f.moves == 0;
+            idle_since_finish = f.moves == 0 && !only_when_untangled;
             ++result.finishes;
             result.finish_moves += f.moves;
             result.seconds_finish += seconds_since(begin);
