@@ -128,3 +128,20 @@ TEST_CASE("untangle: the input is kept when no try is less tangled", "[untangle]
         CHECK(out.layer(l).points == input.layer(l).points);
     check_report(r, out, input, judged(out, input));
 }
+
+TEST_CASE("untangle: a pass does not repeat a finishing run that moved nothing", "[untangle]") {
+    // One try on the folded stack at 95% (one round a pass, no pass clean). The finishing stage
+    // runs before the first check, at the end of every round and at the end of every pass; the
+    // pass's run is left out where the round's run just before it moved nothing (it undid its
+    // moves on that tangle), since it would start from the same scene and end the same.
+    const Scene input = read_scene(test::test_data("folded_stack_tangled_95.json"));
+    UntangleParams params;
+    params.outside_sides = untangling_outside_sides(input);
+    REQUIRE(params.max_rounds == 1);
+    Scene s = input;
+    const UntangleReport r = detail::run_untangling(s, whole_scene_pieces(s), params, {});
+    REQUIRE_FALSE(r.collision_free);
+    REQUIRE(r.rounds == r.passes);
+    CHECK(r.finishes < 1 + 2 * r.passes);
+    CHECK(r.finishes > r.passes);
+}
