@@ -309,8 +309,8 @@ EngineResult run_engine(Scene& work, const std::vector<Piece>& pieces, const Unt
             if (result.ok) break;
         }
         result.seconds_untangle += seconds_since(start);
-        // A pass whose last round ended with a finishing run that moved nothing (often one
-        // that undid its moves) would repeat that run on the same scene.
+        // A pass whose last round ended with a full finishing run that moved nothing (often
+        // one that undid its moves) would repeat that run on the same scene.
         if (!result.ok && !idle_since_finish) finish_and_check(false);
     }
     return result;
