@@ -6,6 +6,7 @@
 #include "strata/core/format.h"
 #include "strata/geometry/checks.h"
 #include "strata/io/scene_io.h"
+#include "strata/io/svg_io.h"
 
 #include <nlohmann/json.hpp>
 
@@ -23,6 +24,7 @@ namespace {
 struct CheckOptions {
     std::string input;
     std::string reference;
+    std::string svg;
     bool json = false;
     bool strict = false;
     CheckParams params;
@@ -170,6 +172,44 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
                                                              : "NOT collision-free"));
 }
 
+// The scene with what the check found marked (SvgWriteParams::marks): the listed crossings,
+// self-crossings, vertices on the wrong side and vertices closer than required, and a line
+// between the closest points of each near pair below its required gap.
+SvgWriteParams marked(const Scene& scene, const CheckReport& r, double tolerance) {
+    SvgWriteParams svg;
+    svg.draw_vertices = true;
+    auto name = [&](std::size_t layer) { return shown_name(scene.layer(layer).name); };
+    auto at = [&](std::size_t layer, std::size_t vertex) {
+        return scene.layer(layer).points[vertex];
+    };
+    for (const Crossing& c : r.crossings)
+        svg.marks.push_back({c.point, c.point,
+                             std::string(c.is_touch ? "touch" : "crossing") + ": " +
+                                 name(c.layer_a) + " segment " + std::to_string(c.segment_a) +
+                                 ", " + name(c.layer_b) + " segment " +
+                                 std::to_string(c.segment_b)});
+    for (const Crossing& c : r.self_crossings)
+        svg.marks.push_back({c.point, c.point,
+                             "self-crossing: " + name(c.layer_a) + " segments " +
+                                 std::to_string(c.segment_a) + " and " +
+                                 std::to_string(c.segment_b)});
+    for (const NestingViolation& v : r.nesting_violations)
+        svg.marks.push_back({at(v.layer, v.vertex), at(v.layer, v.vertex),
+                             "wrong side: " + name(v.layer) + " vertex " +
+                                 std::to_string(v.vertex) + " against " + name(v.other)});
+    for (const SeparationViolation& v : r.separation_violations)
+        svg.marks.push_back({at(v.layer, v.vertex), at(v.layer, v.vertex),
+                             "too close: " + name(v.layer) + " vertex " + std::to_string(v.vertex) +
+                                 " is " + num(v.distance) + " from " + name(v.other) +
+                                 ", required " + num(v.required)});
+    for (const PairSeparation& p : r.pairs)
+        if (p.required > 0.0 && p.gap < p.required * (1.0 - tolerance))
+            svg.marks.push_back({p.at_a, p.at_b,
+                                 "closest: " + name(p.layer_a) + " and " + name(p.layer_b) +
+                                     ", gap " + num(p.gap) + ", required " + num(p.required)});
+    return svg;
+}
+
 }  // namespace
 
 Run add_check_command(CLI::App& app) {
@@ -182,6 +222,10 @@ Run add_check_command(CLI::App& app) {
                     "Original scene: adds per-layer Hausdorff distances, and gives each open "
                     "layer the outside side it has there (as simplify's own check does)");
     cmd->add_flag("--json", opt->json, "Print the report as JSON");
+    cmd->add_option("--svg", opt->svg,
+                    "Picture of the scene with the problems found marked in red (crossings, "
+                    "vertices on the wrong side or too close, the closest points of pairs "
+                    "below their gap; hover for details)");
     cmd->add_flag("--strict", opt->strict, "Separation shortfalls make the exit code 1");
     cmd->add_option("--near", opt->params.near_distance,
                     "Pairs closer than this get a separation entry (scene units; 0 = auto)")
@@ -194,6 +238,7 @@ Run add_check_command(CLI::App& app) {
         ->capture_default_str();
     return [opt]() {
         validate(opt->params);
+        if (!opt->svg.empty()) check_outputs({opt->svg}, {opt->input, opt->reference});
         const Scene scene = read_scene(opt->input);
         for (const std::string& note : scene.diagnostics().notes)
             std::cerr << "strata: note: " << opt->input << ": " << note << '\n';
@@ -218,6 +263,8 @@ Run add_check_command(CLI::App& app) {
                              opt->hausdorff_tolerance * std::max(diagonal, 1e-300));
         }
         const bool ok = report.is_collision_free() && (!opt->strict || report.separations_hold());
+        if (!opt->svg.empty())
+            write_scene_svg(scene, opt->svg, marked(scene, report, params.separation_tolerance));
         if (opt->json) {
             nlohmann::json out = to_json(scene, report, h, ok);
             // Rolled or folded-over vertices of the reference (their own side kept), if any.

@@ -1136,6 +1136,27 @@ std::string scene_to_svg(const Scene& scene, const SvgWriteParams& params) {
                element_name(layer) + ">\n";
         if (params.draw_vertices) out += dots(layer, colour);
     }
+    if (!params.marks.empty()) {
+        const std::string r = format_number(4.0 * std::max(1.0, params.stroke_px) * px);
+        auto y = [](double v) { return format_number(0.0 - v); };  // 0 -> "0", not "-0"
+        out += "<g" + attribute("data-strata-role", "marks") + attribute("fill", "none") +
+               attribute("stroke", "#d00000") + attribute("stroke-width", stroke) + ">\n";
+        for (const SvgMark& mark : params.marks) {
+            // (A title XML cannot hold is shown as the escaped names are.)
+            const std::string shown =
+                is_xml_text(mark.title)
+                    ? mark.title
+                    : shown_text(mark.title, std::numeric_limits<std::size_t>::max());
+            const std::string title = "<title>" + xml_escape(shown) + "</title>";
+            out += "  <circle" + attribute("cx", format_number(mark.at.x)) +
+                   attribute("cy", y(mark.at.y)) + attribute("r", r) + ">" + title + "</circle>\n";
+            if (mark.to != mark.at)
+                out += "  <line" + attribute("x1", format_number(mark.at.x)) +
+                       attribute("y1", y(mark.at.y)) + attribute("x2", format_number(mark.to.x)) +
+                       attribute("y2", y(mark.to.y)) + ">" + title + "</line>\n";
+        }
+        out += "</g>\n";
+    }
     out += "</svg>\n";
     return out;
 }

@@ -430,6 +430,32 @@ TEST_CASE("Scene -> SVG -> Scene is exact", "[io][svg]") {
     }
 }
 
+TEST_CASE("marks are drawn over the scene and skipped when it is read back", "[io][svg]") {
+    const Scene scene = test::nested_circles(2, 16);
+    SvgWriteParams params;
+    params.marks.push_back({Vec2(1.0, 0.5), Vec2(1.0, 0.5), "crossing: a<b & \"c\""});
+    params.marks.push_back({Vec2(0.0, 1.0), Vec2(0.0, 1.25), "closest"});
+    params.marks.push_back({Vec2(0.5, 0.5), Vec2(0.5, 0.5), "name \x1b"});
+    const std::string svg = scene_to_svg(scene, params);
+    const std::size_t group = svg.find("<g data-strata-role=\"marks\"");
+    REQUIRE(group != std::string::npos);
+    CHECK(group > svg.find("circle_1\""));  // over the layers
+    // A ring per mark (y flipped), a line only for the one whose `to` differs.
+    std::size_t rings = 0;
+    for (std::size_t at = svg.find("<circle", group); at != std::string::npos;
+         at = svg.find("<circle", at + 1))
+        ++rings;
+    CHECK(rings == 3);
+    CHECK_THAT(svg, Contains("<circle cx=\"1\" cy=\"-0.5\""));
+    CHECK_THAT(svg, Contains("<line x1=\"0\" y1=\"-1\" x2=\"0\" y2=\"-1.25\"><title>closest"));
+    CHECK(svg.find("<line") == svg.rfind("<line"));
+    CHECK_THAT(svg, Contains("<title>crossing: a&lt;b &amp; &quot;c&quot;</title>"));
+    CHECK_THAT(svg, Contains("<title>name \\x1b</title>"));  // XML cannot hold ESC
+    test::require_same_scene(scene, parse_scene_svg(svg, "marked.svg"), false);
+    // No marks: no group.
+    CHECK_THAT(scene_to_svg(scene), !Contains("data-strata-role=\"marks\""));
+}
+
 TEST_CASE("names XML cannot hold are written as shown_text() shows them and read back",
           "[io][svg]") {
     // XML 1.0 holds no C0 control but tab, newline and return (not even as &#27;) and no byte of

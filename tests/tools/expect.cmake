@@ -1,6 +1,6 @@
 # Runs one command and checks its exit code and output.
 # -DCOMMAND="a|b|c" -DEXPECT_CODE=N [-DEXPECT_OUT=regex] [-DEXPECT_ERR=regex] [-DREJECT_OUT=regex]
-# [-DEXPECT_NO_FILE=path] [-DEXPECT_FILE=path]
+# [-DEXPECT_NO_FILE=path] [-DEXPECT_FILE=path [-DFILE_MATCH=regex] [-DFILE_REJECT=regex]]
 string(REPLACE "|" ";" COMMAND "${COMMAND}")
 execute_process(COMMAND ${COMMAND} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT "${code}" STREQUAL "${EXPECT_CODE}")
@@ -20,4 +20,13 @@ if(DEFINED EXPECT_NO_FILE AND EXISTS "${EXPECT_NO_FILE}")
 endif()
 if(DEFINED EXPECT_FILE AND NOT EXISTS "${EXPECT_FILE}")
   message(FATAL_ERROR "${EXPECT_FILE} was not written")
+endif()
+if(DEFINED EXPECT_FILE AND (DEFINED FILE_MATCH OR DEFINED FILE_REJECT))
+  file(READ "${EXPECT_FILE}" content)
+  if(DEFINED FILE_MATCH AND NOT content MATCHES "${FILE_MATCH}")
+    message(FATAL_ERROR "${EXPECT_FILE} does not match '${FILE_MATCH}'")
+  endif()
+  if(DEFINED FILE_REJECT AND content MATCHES "${FILE_REJECT}")
+    message(FATAL_ERROR "${EXPECT_FILE} matches '${FILE_REJECT}'")
+  endif()
 endif()

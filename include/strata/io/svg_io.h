@@ -17,8 +17,8 @@
 /// - `transform` functions: matrix, translate, scale, rotate (with optional centre), skewX,
 ///   skewY, in lists. The root's viewBox is ignored: points are in the root's user units.
 /// - Skipped: the content of <defs>, <clipPath>, <mask>, <symbol>, <marker>, <pattern>, and
-///   any element whose data-strata-role is not "layer" (the writer marks its underlay and
-///   vertex dots "underlay" and "vertices").
+///   any element whose data-strata-role is not "layer" (the writer marks its underlay, vertex
+///   dots and marks "underlay", "vertices" and "marks").
 /// - When any element has data-outer, every layer has `outer` set (empty when absent);
 ///   otherwise the document order is one implicit stack. data-strata-units on the root <svg>
 ///   gives the scene's units. Layer::extra and Scene::metadata are not carried by SVG.
@@ -60,6 +60,15 @@ Scene parse_scene_svg(std::string_view text, const std::string& source = "<svg>"
 /// parse_scene_svg() of a file's content. @throws IoError unreadable file.
 Scene read_scene_svg(const std::filesystem::path& path, const SvgReadParams& params = {});
 
+/// A place to point at in a picture (e.g. a crossing found by check_scene()): a red ring at
+/// `at`, and, when `to` differs from `at`, a red line from `at` to `to` (e.g. the two closest
+/// points of a pair of layers closer than required). Scene units. `title` is shown on hover.
+struct SvgMark {
+    Vec2 at{0.0};
+    Vec2 to{0.0};
+    std::string title;
+};
+
 /// Parameters of scene_to_svg().
 struct SvgWriteParams {
     const Scene* underlay =
@@ -67,6 +76,9 @@ struct SvgWriteParams {
     double width_px = 800.0;     ///< Width of the picture in pixels; height keeps the aspect.
     double stroke_px = 1.5;      ///< Stroke width of the layers in pixels.
     bool draw_vertices = false;  ///< Small dots at the vertices.
+    /// Drawn over the scene, in a <g data-strata-role="marks"> that parse_scene_svg() skips.
+    /// They do not widen the picture: marks outside the scene's box are cut off.
+    std::vector<SvgMark> marks;
 };
 
 /// Throws InvalidInput naming the first out-of-range field (width_px > 0, stroke_px >= 0).
