@@ -1,4 +1,5 @@
 // strata check: exact collision checks of a scene, as a table or JSON.
+#include "check_marks.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "reference.h"
@@ -30,13 +31,6 @@ struct CheckOptions {
     CheckParams params;
     double hausdorff_tolerance = 1e-9;
 };
-
-std::string num(double v) {
-    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-}
 
 // Per-layer Hausdorff distance to the layer of the same name in `reference` (nullopt if absent).
 std::vector<std::optional<HausdorffDistance>> hausdorff_to(const Scene& scene,
@@ -135,9 +129,10 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
     for (std::size_t i = 0; i < scene.size(); ++i) {
         const Layer& l = scene.layer(i);
         std::string hd =
-            h.empty() ? "" : (h[i] ? "  " + num(h[i]->symmetric()) : "  (not in reference)");
+            h.empty() ? ""
+                      : (h[i] ? "  " + short_number(h[i]->symmetric()) : "  (not in reference)");
         std::printf("  %-20s %-6s %8zu %10s %6zu%s\n", shown_name(l.name).c_str(),
-                    l.closed ? "yes" : "no", l.points.size(), num(l.thickness).c_str(),
+                    l.closed ? "yes" : "no", l.points.size(), short_number(l.thickness).c_str(),
                     r.self_crossing_count[i], hd.c_str());
     }
     std::printf("crossings between layers: %zu (%zu proper, %zu touching)\n", r.crossing_count,
@@ -145,13 +140,15 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
     for (std::size_t k = 0; k < r.crossings.size() && k < 10; ++k) {
         const Crossing& c = r.crossings[k];
         std::printf("  %s at (%s, %s): '%s' segment %zu x '%s' segment %zu\n",
-                    c.is_touch ? "touch" : "cross", num(c.point.x).c_str(), num(c.point.y).c_str(),
+                    c.is_touch ? "touch" : "cross", short_number(c.point.x).c_str(),
+                    short_number(c.point.y).c_str(),
                     shown_name(scene.layer(c.layer_a).name).c_str(), c.segment_a,
                     shown_name(scene.layer(c.layer_b).name).c_str(), c.segment_b);
     }
     if (r.crossing_count > 10) std::printf("  ... (--json lists up to %zu)\n", r.crossings.size());
     std::printf("self-crossings: %zu\n", r.total_self_crossings());
-    std::printf("near pairs (closer than %s): %zu\n", num(r.near_distance).c_str(), r.pairs.size());
+    std::printf("near pairs (closer than %s): %zu\n", short_number(r.near_distance).c_str(),
+                r.pairs.size());
     if (!r.pairs.empty())
         std::printf("  %-20s %-20s %-12s %12s %12s %8s\n", "layer a", "layer b", "relation", "gap",
                     "required", "ratio");
@@ -159,9 +156,10 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
         std::printf("  %-20s %-20s %-12s %12s %12s %8s\n",
                     shown_name(scene.layer(p.layer_a).name).c_str(),
                     shown_name(scene.layer(p.layer_b).name).c_str(), relation_name(p.relation),
-                    num(p.gap).c_str(), num(p.required).c_str(), num(p.ratio()).c_str());
+                    short_number(p.gap).c_str(), short_number(p.required).c_str(),
+                    short_number(p.ratio()).c_str());
     std::printf("min separation ratio: %s; vertices closer than required: %zu\n",
-                num(r.min_separation_ratio).c_str(), r.separation_violation_count);
+                short_number(r.min_separation_ratio).c_str(), r.separation_violation_count);
     std::printf(
         "nesting: %s\n",
         r.nesting_violation_count == 0
@@ -170,44 +168,6 @@ void print_table(const std::string& input, const Scene& scene, const CheckReport
     std::printf("verdict: %s\n", ok ? "OK"
                                     : (r.is_collision_free() ? "separation too small (--strict)"
                                                              : "NOT collision-free"));
-}
-
-// The scene with what the check found marked (SvgWriteParams::marks): the listed crossings,
-// self-crossings, vertices on the wrong side and vertices closer than required, and a line
-// between the closest points of each near pair below its required gap.
-SvgWriteParams marked(const Scene& scene, const CheckReport& r, double tolerance) {
-    SvgWriteParams svg;
-    svg.draw_vertices = true;
-    auto name = [&](std::size_t layer) { return shown_name(scene.layer(layer).name); };
-    auto at = [&](std::size_t layer, std::size_t vertex) {
-        return scene.layer(layer).points[vertex];
-    };
-    for (const Crossing& c : r.crossings)
-        svg.marks.push_back({c.point, c.point,
-                             std::string(c.is_touch ? "touch" : "crossing") + ": " +
-                                 name(c.layer_a) + " segment " + std::to_string(c.segment_a) +
-                                 ", " + name(c.layer_b) + " segment " +
-                                 std::to_string(c.segment_b)});
-    for (const Crossing& c : r.self_crossings)
-        svg.marks.push_back({c.point, c.point,
-                             "self-crossing: " + name(c.layer_a) + " segments " +
-                                 std::to_string(c.segment_a) + " and " +
-                                 std::to_string(c.segment_b)});
-    for (const NestingViolation& v : r.nesting_violations)
-        svg.marks.push_back({at(v.layer, v.vertex), at(v.layer, v.vertex),
-                             "wrong side: " + name(v.layer) + " vertex " +
-                                 std::to_string(v.vertex) + " against " + name(v.other)});
-    for (const SeparationViolation& v : r.separation_violations)
-        svg.marks.push_back({at(v.layer, v.vertex), at(v.layer, v.vertex),
-                             "too close: " + name(v.layer) + " vertex " + std::to_string(v.vertex) +
-                                 " is " + num(v.distance) + " from " + name(v.other) +
-                                 ", required " + num(v.required)});
-    for (const PairSeparation& p : r.pairs)
-        if (p.required > 0.0 && p.gap < p.required * (1.0 - tolerance))
-            svg.marks.push_back({p.at_a, p.at_b,
-                                 "closest: " + name(p.layer_a) + " and " + name(p.layer_b) +
-                                     ", gap " + num(p.gap) + ", required " + num(p.required)});
-    return svg;
 }
 
 }  // namespace
@@ -263,8 +223,11 @@ Run add_check_command(CLI::App& app) {
                              opt->hausdorff_tolerance * std::max(diagonal, 1e-300));
         }
         const bool ok = report.is_collision_free() && (!opt->strict || report.separations_hold());
-        if (!opt->svg.empty())
-            write_scene_svg(scene, opt->svg, marked(scene, report, params.separation_tolerance));
+        if (!opt->svg.empty()) {
+            SvgWriteParams svg = check_marks(scene, report, params.separation_tolerance);
+            svg.draw_vertices = true;
+            write_scene_svg(scene, opt->svg, svg);
+        }
         if (opt->json) {
             nlohmann::json out = to_json(scene, report, h, ok);
             // Rolled or folded-over vertices of the reference (their own side kept), if any.

@@ -1,4 +1,5 @@
 // strata simplify: collision-free simplification of one scene, a demo, or a batch of slices.
+#include "check_marks.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "simplify_batch.h"
@@ -106,9 +107,10 @@ int run_demo(const SimplifyOptions& opt) {
     write_file_atomic(
         dir / "compare.svg",
         panels_to_svg(
-            {{"input (" + std::to_string(input.vertex_count()) + " vertices)", &input, nullptr},
-             {"naive decimation: layers cross", &naive, &input},
-             {"strata: collision-free", &result, &input}},
+            {{"input (" + std::to_string(input.vertex_count()) + " vertices)", &input, nullptr, {}},
+             {"naive decimation: layers cross (red)", &naive, &input,
+              contact_marks(naive, check_scene(naive))},
+             {"strata: collision-free", &result, &input, {}}},
             svg));
     nlohmann::json j = report_json(*o.report, &*o.naive);
     j["peak_memory_mib"] = peak_memory_mib();
@@ -271,11 +273,15 @@ Run add_simplify_command(CLI::App& app) {
         if (!o.svg.empty()) {
             SvgWriteParams svg;
             svg.width_px = 1000.0;
-            std::vector<SvgPanel> panels{
-                {untangled ? "input (crossing)" : "input", &input, nullptr}};
-            if (untangled) panels.push_back({"input untangled", &*prepared, &input});
-            if (naive_report && !o.naive) panels.push_back({"naive decimation", &naive, &input});
-            panels.push_back({o.naive ? "naive decimation" : "strata", &result, &input});
+            // Where the input and the naive decimation cross, marked in red.
+            auto crossings = [](const Scene& s) { return contact_marks(s, check_scene(s)); };
+            std::vector<SvgPanel> panels{{untangled ? "input (crossing)" : "input", &input, nullptr,
+                                          untangled ? crossings(input) : std::vector<SvgMark>{}}};
+            if (untangled) panels.push_back({"input untangled", &*prepared, &input, {}});
+            if (naive_report && !o.naive)
+                panels.push_back({"naive decimation", &naive, &input, crossings(naive)});
+            panels.push_back({o.naive ? "naive decimation" : "strata", &result, &input,
+                              o.naive ? crossings(result) : std::vector<SvgMark>{}});
             write_file_atomic(o.svg, panels_to_svg(panels, svg));
         }
         if (!o.report.empty()) {

@@ -1,4 +1,5 @@
 // strata untangle: global untangling of a scene that is already tangled.
+#include "check_marks.h"
 #include "cli_util.h"
 #include "commands.h"
 #include "reference.h"
@@ -48,7 +49,9 @@ Run add_untangle_command(CLI::App& app) {
                                        "0 when the result is collision-free)");
     cmd->add_option("input", opt->input, "Scene file (.json or .svg)")->required();
     cmd->add_option("-o,--output", opt->output, "Untangled scene (.json or .svg)")->required();
-    cmd->add_option("--svg", opt->svg, "Picture: the result over the input (faint)");
+    cmd->add_option("--svg", opt->svg,
+                    "Picture: the result over the input (faint), what is left tangled marked in "
+                    "red");
     cmd->add_option("--report", opt->report, "Report as JSON");
     cmd->add_option("--reference", opt->reference,
                     "Original scene (before decimation), layers matched by name: every vertex "
@@ -145,11 +148,14 @@ Run add_untangle_command(CLI::App& app) {
             params.input_sides = &inferred;
             check_params.input_sides = &inferred;
         }
+        // (Vertices closer than untangle() allows are listed for the picture.)
+        check_params.separation_tolerance = params.separation_tolerance;
         const CheckReport after = check_scene(scene, check_params);
 
         write_scene(scene, opt->output);
         if (!opt->svg.empty()) {
-            SvgWriteParams svg;
+            // What is left when the result is not clean, marked in red.
+            SvgWriteParams svg = check_marks(scene, after, params.separation_tolerance);
             svg.underlay = &input;
             write_scene_svg(scene, opt->svg, svg);
         }

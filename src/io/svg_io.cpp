@@ -1187,6 +1187,7 @@ std::string panels_to_svg(const std::vector<SvgPanel>& panels, const SvgWritePar
     for (const SvgPanel& panel : panels) {
         SvgWriteParams one = params;
         one.underlay = panel.underlay;
+        one.marks = panel.marks;
         std::string svg = scene_to_svg(*panel.scene, one);
         svg = svg.substr(svg.find("<svg"));  // drop the XML declaration
         const double h = svg_height(svg);

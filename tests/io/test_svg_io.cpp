@@ -454,6 +454,14 @@ TEST_CASE("marks are drawn over the scene and skipped when it is read back", "[i
     test::require_same_scene(scene, parse_scene_svg(svg, "marked.svg"), false);
     // No marks: no group.
     CHECK_THAT(scene_to_svg(scene), !Contains("data-strata-role=\"marks\""));
+    // Side by side: each panel's own marks only.
+    const std::string panels = panels_to_svg(
+        {{"marked", &scene, nullptr, {params.marks[1]}}, {"plain", &scene, nullptr, {}}});
+    const std::size_t first = panels.find("data-strata-role=\"marks\"");
+    REQUIRE(first != std::string::npos);
+    CHECK(panels.find("data-strata-role=\"marks\"", first + 1) == std::string::npos);
+    CHECK(first < panels.find("plain"));
+    CHECK_THAT(panels, Contains("<title>closest</title>"));
 }
 
 TEST_CASE("names XML cannot hold are written as shown_text() shows them and read back",

@@ -93,6 +93,7 @@ struct SvgPanel {
     std::string title;                ///< Caption drawn above the picture.
     const Scene* scene = nullptr;     ///< Drawn in colour.
     const Scene* underlay = nullptr;  ///< Optional, drawn faintly under it.
+    std::vector<SvgMark> marks;       ///< Drawn over it (SvgWriteParams::marks).
 };
 
 /// Several scenes side by side (stacked vertically when they are wider than tall), each with
