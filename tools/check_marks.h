@@ -19,11 +19,11 @@ std::string short_number(double v);
 std::vector<SvgMark> contact_marks(const Scene& scene, const CheckReport& report);
 
 /// Picture settings for `scene` with the problems `report` (check_scene() of `scene`) lists
-/// marked (SvgWriteParams::marks): contact_marks(), then each vertex
-/// on the wrong side or closer than required, and a line between the closest points of each
-/// near pair whose gap is below required x (1 - `separation_tolerance`). Each mark's title
-/// names the layers (as shown_name() shows them), the segments or vertex, and the distances.
-/// Nothing else of the settings is changed from the defaults.
+/// marked (SvgWriteParams::marks): contact_marks(), then each vertex on the wrong side or
+/// closer than required, and a line between the closest points of each near pair whose gap is
+/// below required x (1 - `separation_tolerance`). Each mark's title names the layers (as
+/// shown_name() shows them), the segments or vertex, and the distances. Nothing else of the
+/// settings is changed from the defaults.
 SvgWriteParams check_marks(const Scene& scene, const CheckReport& report,
                            double separation_tolerance);
 
