@@ -183,9 +183,9 @@ Run add_check_command(CLI::App& app) {
                     "layer the outside side it has there (as simplify's own check does)");
     cmd->add_flag("--json", opt->json, "Print the report as JSON");
     cmd->add_option("--svg", opt->svg,
-                    "Picture of the scene with the problems found marked in red (crossings, "
-                    "vertices on the wrong side or too close, the closest points of pairs "
-                    "below their gap; hover for details)");
+                    "Picture of the scene (with its vertices, up to 10000) and the problems "
+                    "found marked in red (crossings, vertices on the wrong side or too close, "
+                    "the closest points of pairs below their gap; hover for details)");
     cmd->add_flag("--strict", opt->strict, "Separation shortfalls make the exit code 1");
     cmd->add_option("--near", opt->params.near_distance,
                     "Pairs closer than this get a separation entry (scene units; 0 = auto)")
@@ -225,7 +225,8 @@ Run add_check_command(CLI::App& app) {
         const bool ok = report.is_collision_free() && (!opt->strict || report.separations_hold());
         if (!opt->svg.empty()) {
             SvgWriteParams svg = check_marks(scene, report, params.separation_tolerance);
-            svg.draw_vertices = true;
+            // Vertex dots where they stay readable (and the file small).
+            svg.draw_vertices = scene.vertex_count() <= 10000;
             write_scene_svg(scene, opt->svg, svg);
         }
         if (opt->json) {
