@@ -195,6 +195,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"untwisted", r.untwisted},
                 {"restarted", r.restarted},
                 {"ends_by_nearest", r.ends_by_nearest},
+                {"end_sides_dropped", r.end_sides_dropped},
                 {"input_kept", r.input_kept},
                 {"gave_up", r.gave_up}};
             if (params.input_sides)
@@ -218,6 +219,11 @@ Run add_untangle_command(CLI::App& app) {
                                                 std::to_string(r.sides_reading) + ")"
                                           : " (the least tangled try kept was by the inferred "
                                             "sides)";
+            else if (r.end_sides_dropped)
+                why =
+                    " (the input's rolled regions as inferred did not come out clean: kept the "
+                    "first other reading of those regions with no side around another layer's "
+                    "end, tried before the global order)";
             else if (r.sides_reading > 0)
                 why =
                     " (neither the input's rolled regions as inferred nor the global order "

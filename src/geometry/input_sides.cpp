@@ -662,11 +662,11 @@ std::size_t InputSides::vertex_count(std::size_t a) const {
     return r == kNoLayer ? 0 : recorded_->scene.layer(r).points.size();
 }
 
-std::vector<InputSides> InputSides::loop_readings(const Scene& scene) const {
-    if (empty()) return {};
+std::vector<std::vector<signed char>> InputSides::codes_for(const Scene& scene,
+                                                            const char* what) const {
     if (scene.size() != n_)
-        throw InvalidInput("input sides: loop_readings() got " + std::to_string(scene.size()) +
-                           " layers for " + std::to_string(n_));
+        throw InvalidInput(std::string("input sides: ") + what + " got " +
+                           std::to_string(scene.size()) + " layers for " + std::to_string(n_));
     std::vector<std::vector<signed char>> codes(n_ * n_);
     for (std::size_t a = 0; a < n_; ++a)
         for (std::size_t b = 0; b < n_; ++b) {
@@ -679,6 +679,21 @@ std::vector<InputSides> InputSides::loop_readings(const Scene& scene) const {
                 out[k] = static_cast<signed char>(c);
             }
         }
+    return codes;
+}
+
+InputSides InputSides::without_end_sides(const Scene& scene) const {
+    if (empty()) return {};
+    std::vector<std::vector<signed char>> codes = codes_for(scene, "without_end_sides()");
+    for (std::vector<signed char>& pair : codes)
+        for (signed char& c : pair)
+            if (c == kBeyondEnd) c = 0;
+    return from_codes(scene, std::move(codes));
+}
+
+std::vector<InputSides> InputSides::loop_readings(const Scene& scene) const {
+    if (empty()) return {};
+    const std::vector<std::vector<signed char>> codes = codes_for(scene, "loop_readings()");
     std::vector<InputSides> readings;
     for (std::size_t a = 0; a < n_; ++a)
         for (std::size_t b = 0; b < n_; ++b) {
@@ -704,22 +719,16 @@ std::vector<InputSides> InputSides::loop_readings(const Scene& scene) const {
 
 InputSides InputSides::off_other_sheets(const Scene& scene) const {
     if (empty()) return {};
-    if (scene.size() != n_)
-        throw InvalidInput("input sides: off_other_sheets() got " + std::to_string(scene.size()) +
-                           " layers for " + std::to_string(n_));
     const Recorded& rec = *recorded_;
-    std::vector<std::vector<signed char>> codes(n_ * n_);
+    std::vector<std::vector<signed char>> codes = codes_for(scene, "off_other_sheets()");
     std::vector<std::unique_ptr<SegmentIndex>> indices(n_);
     for (std::size_t a = 0; a < n_; ++a)
         for (std::size_t b = 0; b < n_; ++b) {
             if (a == b || scene.layer(b).closed || scene.layer(b).points.size() < 2) continue;
             const std::vector<Vec2>& points = scene.layer(a).points;
             std::vector<signed char>& out = codes[a * n_ + b];
-            for (std::size_t k = 0; k < points.size(); ++k) {
-                const int c = code(a, k, b);
-                if (c == 0 && out.empty()) continue;
-                out.resize(points.size(), 0);
-                out[k] = static_cast<signed char>(c);
+            for (std::size_t k = 0; k < out.size(); ++k) {
+                const int c = out[k];
                 if (c != 1 && c != -1) continue;
                 if (!indices[b]) indices[b] = std::make_unique<SegmentIndex>(scene.layer(b));
                 const Nearest now = nearest_on(*indices[b], points[k]);

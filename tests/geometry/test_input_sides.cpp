@@ -60,3 +60,24 @@ TEST_CASE("sides by region: a roll is kept, a vertex a tangle put across takes i
 
     CHECK_THROWS_AS(raw.by_region(Scene({layers[0]})), InvalidInput);
 }
+
+TEST_CASE("without_end_sides: the vertices around an end lose it, the others keep their side",
+          "[rolled][input_sides]") {
+    const Scene input = test::wavy_roll(300, 2.0);
+    const InputSides recorded = record_input_sides(input);
+    const InputSides dropped = recorded.without_end_sides(input);
+    std::size_t around = 0, sided = 0;
+    for (std::size_t l = 0; l < input.size(); ++l)
+        for (std::size_t k = 0; k < input.layer(l).points.size(); ++k)
+            for (std::size_t m = 0; m < input.size(); ++m) {
+                CHECK_FALSE(dropped.beyond_end(l, k, m));
+                CHECK(dropped.side(l, k, m) == recorded.side(l, k, m));
+                if (recorded.beyond_end(l, k, m)) ++around;
+                if (recorded.side(l, k, m) != 0) ++sided;
+            }
+    // The roll's bend goes around the outer layer's end; both sides are read elsewhere.
+    CHECK(around > 0);
+    CHECK(sided > 0);
+    CHECK(InputSides().without_end_sides(input).empty());
+    CHECK_THROWS_AS(recorded.without_end_sides(Scene({input.layer(0)})), InvalidInput);
+}

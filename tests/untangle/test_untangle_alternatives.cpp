@@ -705,3 +705,39 @@ TEST_CASE(
         CHECK(check.nesting_violation_count == 0);
     }
 }
+
+TEST_CASE(
+    "untangle_inferring_sides: the first other reading without end sides before the global "
+    "order",
+    "[untangle][rolled]") {
+    // Out of sample: the shirt at 95%, seed 60. Body vertices cut off by the shirt's chord are
+    // read on the shirt's far side, the tries by the inferred sides fail, and the global order
+    // came out clean with the shirt unrolled (dirty by the original). The first other reading
+    // (the whole body on the global order's side) with no side around the shirt's decimated end
+    // comes out clean with the roll kept.
+    const Scene input = make_scene(SceneFamily::ShirtRoll);
+    const Scene tangled = naive_decimation(input, 0.95, 60);
+    REQUIRE(check_scene(tangled).crossing_count > 0);
+    const std::vector<int> outside = untangling_outside_sides(tangled);
+    REQUIRE(infer_input_sides(tangled, {}, outside).rolled_count(tangled, outside) > 0);
+
+    Scene out = tangled;
+    const UntangleReport report = untangle_inferring_sides(out);
+    CHECK(report.collision_free);
+    CHECK(report.end_sides_dropped);
+    CHECK(report.inferred_sides);
+    CHECK(report.sides_reading == 1);
+    const CheckReport c = test::check_by_original(out, input);
+    CHECK(c.is_collision_free());
+    CHECK(c.separations_hold());
+
+    // Without other readings (no such try): the global order unrolls the shirt.
+    UntangleParams without;
+    without.other_readings = 0;
+    Scene unrolled = tangled;
+    const UntangleReport before = untangle_inferring_sides(unrolled, without);
+    CHECK(before.collision_free);
+    CHECK_FALSE(before.end_sides_dropped);
+    CHECK_FALSE(before.inferred_sides);
+    CHECK(test::check_by_original(unrolled, input).nesting_violation_count > 0);
+}

@@ -141,6 +141,13 @@ class InputSides {
     /// had its cord read `-+++-` (the original: `+++++`). Empty: no such loop.
     /// @throws InvalidInput a scene of another layer count.
     std::vector<InputSides> loop_readings(const Scene& scene) const;
+    /// These sides (for `scene`, e.g. a reading of region_alternatives()) with no vertex
+    /// around an end: where beyond_end() holds, the vertex has no side, and the global order
+    /// judges it, as it does a far one. A reading that is wrong only around a decimated end
+    /// (the shirt at 95%, seed 60, out of sample: body vertices read around the shirt's end
+    /// held the shirt's roll open) may be right without those.
+    /// @throws InvalidInput a scene of another layer count.
+    InputSides without_end_sides(const Scene& scene) const;
     /// Vertices whose recorded side is not the one the global order asks for (`outside_sides`:
     /// outside_side() per layer of `scene`, the scene these sides are for): the rolled or
     /// folded-over vertices, once per other layer. Finds the side of every vertex.
@@ -157,6 +164,9 @@ class InputSides {
     /// Sides for `scene` given as codes: codes[a * n + b][k] for vertex k of layer a against
     /// layer b (empty: none).
     static InputSides from_codes(const Scene& scene, std::vector<std::vector<signed char>> codes);
+    /// These sides for `scene` as codes (from_codes()'s); a pair with no code but 0 is empty.
+    /// `what`: the caller, named in the error. @throws InvalidInput another layer count.
+    std::vector<std::vector<signed char>> codes_for(const Scene& scene, const char* what) const;
     /// One other reading of a region (region_alternatives()): pair a * n + b, the region's
     /// first vertex, its vertices' sides, and the agreement score it is ordered by.
     struct Alternative {

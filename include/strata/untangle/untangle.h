@@ -215,8 +215,14 @@ struct UntangleReport {
     bool inferred_sides = false;
     /// With inferred_sides: 0 when the kept sides are the input's regions as inferred
     /// (InputSides::by_region()); i > 0 when neither those nor the global order came out clean
-    /// and the kept sides are the i-th other reading (InputSides::region_alternatives()).
+    /// and the kept sides are the i-th other reading (InputSides::region_alternatives()), or
+    /// with end_sides_dropped, the first without its sides around the ends.
     std::size_t sides_reading = 0;
+    /// untangle_inferring_sides() without an original: the input has rolled regions, the
+    /// tries by them failed, and the result is that of the first other reading of the regions
+    /// with no side around another layer's end (InputSides::without_end_sides()), tried
+    /// before the global order (sides_reading 1).
+    bool end_sides_dropped = false;
     /// untangle(): the first try did not come out clean, and the result is the second, from
     /// the input, in which no vertex move makes a self-crossing.
     bool kept_simple = false;
@@ -279,7 +285,10 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// sides inferred per region of the input (infer_input_sides()), so that a rolled part stays
 /// rolled, both of untangle()'s tries (the second when the first is not clean), then both with
 /// params.long_rounds_factor times the gradient steps (report.long_rounds); a result is kept
-/// when it is clean against those sides (report.inferred_sides). Otherwise, or when none is
+/// when it is clean against those sides (report.inferred_sides). When none is clean (and
+/// params.other_readings > 0), both tries by the first other reading of the regions (below)
+/// with no side around another layer's end (InputSides::without_end_sides(); their failed
+/// results are not kept; report.end_sides_dropped). Otherwise, or when none is
 /// clean, by the global order (untangle() from the input); where nothing is read rolled and the
 /// global order's try is not clean, by the inferred sides, which are then the global order's but
 /// give no side to the vertices around another layer's end (there only the distance counts),
