@@ -229,8 +229,12 @@ Run add_untangle_command(CLI::App& app) {
                     " (neither the input's rolled regions as inferred nor the global order "
                     "came out clean: kept another reading of those regions, number " +
                     std::to_string(r.sides_reading) + ", the clean one that moved least)";
-            else if (r.inferred_sides)
+            else if (r.inferred_sides && r.rolled_vertices > 0)
                 why = " (the input has rolled regions)";
+            else if (r.inferred_sides)
+                why =
+                    " (the global order did not come out clean: kept its sides but none for the "
+                    "vertices around another layer's end, where only the distance counts)";
             else if (r.sides_left_out > 0)
                 why = "; " + std::to_string(r.sides_left_out) +
                       " vertex sides read at the other sheet of a fold the decimation closed "
