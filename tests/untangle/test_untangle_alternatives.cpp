@@ -28,6 +28,13 @@ std::string sides_of(const InputSides& sides, const Scene& scene, std::size_t a,
     return out;
 }
 
+// Vertices that `tangled`'s inferred sides read rolled (InputSides::rolled_count()), by the
+// outside sides an untangling takes.
+std::size_t rolled_read(const Scene& tangled) {
+    const std::vector<int> outside = untangling_outside_sides(tangled);
+    return infer_input_sides(tangled, {}, outside).rolled_count(tangled, outside);
+}
+
 }  // namespace
 
 TEST_CASE("region_alternatives: a roll whose bend was cut across the other layer is split off",
@@ -532,8 +539,7 @@ TEST_CASE("untangle_inferring_sides: without rolled regions the inferred sides a
     const Scene input = make_scene(SceneFamily::Folded, p);
     const Scene tangled = naive_decimation(input, 0.9, 15);
     REQUIRE(check_scene(tangled).crossing_count > 0);
-    const std::vector<int> outside = untangling_outside_sides(tangled);
-    REQUIRE(infer_input_sides(tangled, {}, outside).rolled_count(tangled, outside) == 0);
+    REQUIRE(rolled_read(tangled) == 0);
     Scene out = tangled;
     const UntangleReport report = untangle_inferring_sides(out, UntangleParams{});
     CHECK(report.collision_free);
@@ -718,8 +724,7 @@ TEST_CASE(
     const Scene input = make_scene(SceneFamily::ShirtRoll);
     const Scene tangled = naive_decimation(input, 0.95, 60);
     REQUIRE(check_scene(tangled).crossing_count > 0);
-    const std::vector<int> outside = untangling_outside_sides(tangled);
-    REQUIRE(infer_input_sides(tangled, {}, outside).rolled_count(tangled, outside) > 0);
+    REQUIRE(rolled_read(tangled) > 0);
 
     Scene out = tangled;
     const UntangleReport report = untangle_inferring_sides(out);
