@@ -87,6 +87,12 @@ Run add_untangle_command(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--voxel", p.field.voxel_size, "Grid voxel size (scene units; 0 = auto)")
         ->capture_default_str();
+    cmd->add_option("--stiffer-closed", p.stiffer_closed,
+                    "Without --reference, --infer-sides or --global-order, on a clean result "
+                    "of a scene with closed and open layers: untangle once more by the same "
+                    "sides with the closed layers' weights times this (e.g. 4), and keep the "
+                    "result that moves the vertices less (<= 1: no)")
+        ->capture_default_str();
     add_time_limit_option(*cmd, opt->time_limit, "the untangling");
     add_threads_option(*cmd, opt->threads);
     cmd->add_flag("--give-up-when-stalled", p.give_up_when_stalled,
@@ -196,6 +202,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"restarted", r.restarted},
                 {"ends_by_nearest", r.ends_by_nearest},
                 {"end_sides_dropped", r.end_sides_dropped},
+                {"stiffer_closed", r.stiffer_closed},
                 {"input_kept", r.input_kept},
                 {"gave_up", r.gave_up}};
             if (params.input_sides)
@@ -246,10 +253,15 @@ Run add_untangle_command(CLI::App& app) {
                 reference ? opt->reference.c_str() : opt->input.c_str(), r.rolled_vertices,
                 r.rolled_kept, why.c_str());
         }
+        const std::string stiffer = r.stiffer_closed ? " (kept the result with the closed layers " +
+                                                           short_number(params.stiffer_closed) +
+                                                           "x stiffer: it moved the vertices less)"
+                                                     : "";
         std::printf(
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
-            "%.4g\n",
-            r.min_separation_ratio_after, r.moved_vertices, r.free_vertices, r.max_displacement);
+            "%.4g%s\n",
+            r.min_separation_ratio_after, r.moved_vertices, r.free_vertices, r.max_displacement,
+            stiffer.c_str());
         // Every try failed: the result is the least tangled of theirs, or the input.
         const char* kept = r.collision_free ? ""
                            : r.input_kept   ? " (no try less tangled: kept the input unchanged)"

@@ -221,6 +221,8 @@ void validate(const UntangleParams& params) {
     if (params.max_passes < 1) fail("max_passes", params.max_passes, ">= 1");
     if (!std::isfinite(params.retry_passes_factor))
         fail("retry_passes_factor", params.retry_passes_factor, "finite");
+    if (!std::isfinite(params.stiffer_closed))
+        fail("stiffer_closed", params.stiffer_closed, "finite");
     if (!(params.min_separation >= 0.0) || !std::isfinite(params.min_separation))
         fail("min_separation", params.min_separation, ">= 0 and finite");
     if (!(params.separation_tolerance >= 0.0 && params.separation_tolerance < 1.0))

@@ -842,9 +842,12 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params, const Progre
     });
 }
 
-UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
-                                        const ProgressFn& given, InputSides* kept) {
-    const ProgressFn progress = numbering_tries(given);
+namespace {
+
+// untangle_inferring_sides() but for UntangleParams::stiffer_closed; `progress` numbers the
+// tries already.
+UntangleReport inferring_sides_call(Scene& scene, const UntangleParams& params,
+                                    const ProgressFn& progress, InputSides* kept) {
     const Scene input = scene;
     std::optional<InputSides> tried;
     const UntangleReport report = clean_or_least_tangled(
@@ -871,6 +874,80 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         scene = input;
         throw;
     }
+}
+
+// Whether `scene` has both closed and open layers.
+bool has_closed_and_open(const Scene& scene) {
+    bool closed = false, open = false;
+    for (const Layer& layer : scene.layers()) (layer.closed ? closed : open) = true;
+    return closed && open;
+}
+
+// The mean distance of the vertices of `result` from their places in `input` (same layers).
+double mean_displacement(const Scene& result, const Scene& input) {
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < result.size(); ++i) {
+        const std::vector<Vec2>& p = result.layer(i).points;
+        const std::vector<Vec2>& q = input.layer(i).points;
+        for (std::size_t k = 0; k < p.size() && k < q.size(); ++k, ++count)
+            sum += glm::length(p[k] - q[k]);
+    }
+    return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+}  // namespace
+
+UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
+                                        const ProgressFn& given, InputSides* kept) {
+    const ProgressFn progress = numbering_tries(given);
+    const Scene input = scene;
+    InputSides sides;
+    const UntangleReport first = inferring_sides_call(scene, params, progress, &sides);
+    if (kept && !sides.empty()) *kept = sides;
+    if (!first.collision_free || params.input_sides || !(params.stiffer_closed > 1.0) ||
+        !has_closed_and_open(input))
+        return first;
+    // Without an original, a clean result: untangle()'s tries once more from the input by the
+    // sides it kept (the same reading), with the closed layers stiffer (UntangleParams::
+    // stiffer_closed); kept when clean and its vertices moved less on average.
+    std::vector<Layer> layers = input.layers();
+    for (Layer& layer : layers)
+        if (layer.closed) layer.weight *= params.stiffer_closed;
+    Scene stiffer(std::move(layers), input.units());
+    UntangleParams same = with_outside_sides(input, params);
+    if (!sides.empty()) {
+        same.input_sides = &sides;
+        same.open_cut_bends = false;
+    }
+    UntangleReport second;
+    try {
+        second = clean_or_least_tangled(stiffer, nullptr, [&](LeastTangled& failures) {
+            return untangle_tries(stiffer, same, progress, failures);
+        });
+    } catch (...) {
+        scene = input;
+        throw;
+    }
+    TriesCost cost;
+    cost.add(first);
+    cost.add(second);
+    if (!second.collision_free ||
+        !(mean_displacement(stiffer, input) < mean_displacement(scene, input)))
+        return cost.charged_to(first);
+    for (std::size_t i = 0; i < scene.size(); ++i) scene.set_points(i, stiffer.layer(i).points);
+    // The first result's flags (its reading), the second's counts after.
+    UntangleReport kept_report = first;
+    kept_report.stiffer_closed = true;
+    kept_report.converged = second.converged;
+    kept_report.crossings_after = second.crossings_after;
+    kept_report.self_crossings_after = second.self_crossings_after;
+    kept_report.nesting_violations_after = second.nesting_violations_after;
+    kept_report.min_separation_ratio_after = second.min_separation_ratio_after;
+    kept_report.rolled_kept = second.rolled_kept;
+    kept_report.mean_speed = second.mean_speed;
+    detail::measure_displacement(scene, input, kept_report);
+    return cost.charged_to(kept_report);
 }
 
 }  // namespace strata

@@ -136,6 +136,16 @@ struct UntangleParams {
     /// first try, then the second (no self-crossing made). false: no such retry.
     /// docs/untangle.md, "Ends read by the nearest feature".
     bool retry_ends_by_nearest = true;
+    /// untangle_inferring_sides() without params.input_sides only, on a scene with both closed
+    /// and open layers, when the call comes out clean: untangle()'s tries once more from the
+    /// input by the sides the result kept (the same reading), with every closed layer's weight
+    /// times this factor (a closed layer is the cross-section of a body, a limb or a cord,
+    /// stiffer than the open sheets around it); that result is kept when it is clean and its
+    /// vertices moved less on average (report.stiffer_closed). Where an open layer's chord cut
+    /// across a closed layer, equal weights let the closed layer cave in under it. Off by
+    /// default, not yet measured for time and on every workload: docs/untangle.md, "Closed
+    /// layers stiffer". <= 1: no such call.
+    double stiffer_closed = 1.0;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
     /// queries as fast (docs/field.md, README "Benchmarks"). FieldParams::region is set by the
@@ -223,6 +233,10 @@ struct UntangleReport {
     /// with no side around another layer's end (InputSides::without_end_sides()), tried
     /// before the global order (sides_reading 1).
     bool end_sides_dropped = false;
+    /// untangle_inferring_sides(): the result is that of the call once more with the closed
+    /// layers stiffer (UntangleParams::stiffer_closed), which moved the vertices less on average
+    /// than the first clean result; the other flags are that call's.
+    bool stiffer_closed = false;
     /// untangle(): the first try did not come out clean, and the result is the second, from
     /// the input, in which no vertex move makes a self-crossing.
     bool kept_simple = false;
