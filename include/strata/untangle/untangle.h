@@ -143,8 +143,8 @@ struct UntangleParams {
     /// stiffer than the open sheets around it); that result is kept when it is clean and its
     /// vertices moved less on average (report.stiffer_closed). Where an open layer's chord cut
     /// across a closed layer, equal weights let the closed layer cave in under it. Off by
-    /// default, not yet measured for time and on every workload: docs/untangle.md, "Closed
-    /// layers stiffer". <= 1: no such call.
+    /// default, not yet measured on every workload: docs/untangle.md, "Closed layers stiffer".
+    /// <= 1: no such call.
     double stiffer_closed = 1.0;
     /// Field backend and resolution. The exact indexed backend is the default here: on the
     /// local scenes of the untangling it builds 40-100x faster than the grid and answers
