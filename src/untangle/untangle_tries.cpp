@@ -468,9 +468,9 @@ std::pair<std::size_t, std::size_t> segments_met(const Scene& scene, std::size_t
     return {others, self};
 }
 
-// The report of a clean try `report` (result `result`) that started from the least tangled
-// result of a call (`failed`, its report, from `input`): failed's counts before and flags, the
-// try's counts after, the displacement from `input`.
+// The report of a clean try `report` (result `result`) kept in place of an earlier result of
+// the call (`failed`, its report, from `input`; e.g. the least tangled one it started from):
+// failed's counts before and flags, the try's counts after, the displacement from `input`.
 UntangleReport as_kept(const UntangleReport& failed, const UntangleReport& report,
                        const Scene& result, const Scene& input) {
     UntangleReport kept = failed;
@@ -937,16 +937,8 @@ UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& para
         return cost.charged_to(first);
     for (std::size_t i = 0; i < scene.size(); ++i) scene.set_points(i, stiffer.layer(i).points);
     // The first result's flags (its reading), the second's counts after.
-    UntangleReport kept_report = first;
+    UntangleReport kept_report = as_kept(first, second, scene, input);
     kept_report.stiffer_closed = true;
-    kept_report.converged = second.converged;
-    kept_report.crossings_after = second.crossings_after;
-    kept_report.self_crossings_after = second.self_crossings_after;
-    kept_report.nesting_violations_after = second.nesting_violations_after;
-    kept_report.min_separation_ratio_after = second.min_separation_ratio_after;
-    kept_report.rolled_kept = second.rolled_kept;
-    kept_report.mean_speed = second.mean_speed;
-    detail::measure_displacement(scene, input, kept_report);
     return cost.charged_to(kept_report);
 }
 

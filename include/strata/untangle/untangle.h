@@ -233,9 +233,10 @@ struct UntangleReport {
     /// with no side around another layer's end (InputSides::without_end_sides()), tried
     /// before the global order (sides_reading 1).
     bool end_sides_dropped = false;
-    /// untangle_inferring_sides(): the result is that of the call once more with the closed
+    /// untangle_inferring_sides(): the result is that of the tries once more with the closed
     /// layers stiffer (UntangleParams::stiffer_closed), which moved the vertices less on average
-    /// than the first clean result; the other flags are that call's.
+    /// than the first clean result; the other flags are the first result's (its reading), the
+    /// counts after and the displacement the second's.
     bool stiffer_closed = false;
     /// untangle(): the first try did not come out clean, and the result is the second, from
     /// the input, in which no vertex move makes a self-crossing.
