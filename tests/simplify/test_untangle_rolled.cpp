@@ -140,13 +140,6 @@ bool same_points(const Scene& a, const Scene& b) {
     return true;
 }
 
-double hausdorff_to(const Scene& a, const Scene& b, double tolerance) {
-    double h = 0.0;
-    for (std::size_t l = 0; l < a.size(); ++l)
-        h = std::max(h, hausdorff(a.layer(l), b.layer(l), tolerance).symmetric());
-    return h;
-}
-
 }  // namespace
 
 TEST_CASE("untangle keeps a roll with the original's sides (naive decimation at 90%, 95%)",
@@ -188,9 +181,9 @@ TEST_CASE("untangle keeps a roll with the original's sides (naive decimation at 
                 // At 95% one case moved more (shirt, gap 2, seed 2: +7.9 gaps; a chord of the
                 // shirt across the jacket's end, pulled back along it).
                 const double tol = 1e-6 * c.gap;
-                const double shape_bound =
-                    hausdorff_to(tangled, c.input, tol) + (remove < 0.92 ? 2.0 : 10.0) * c.gap;
-                CHECK(hausdorff_to(out, c.input, tol) <= shape_bound);
+                const double shape_bound = test::hausdorff_to(tangled, c.input, tol) +
+                                           (remove < 0.92 ? 2.0 : 10.0) * c.gap;
+                CHECK(test::hausdorff_to(out, c.input, tol) <= shape_bound);
 
                 // Without the sides, the global order as before: the roll is not kept (the
                 // result is tangled, or unrolled against the original's sides or shape).
@@ -202,7 +195,7 @@ TEST_CASE("untangle keeps a roll with the original's sides (naive decimation at 
                 const auto [judged_global, on_top_global] = still_on_top(c, tangled, global);
                 const bool rolled = g.collision_free && gc.nesting_violation_count == 0 &&
                                     on_top_global == judged_global &&
-                                    hausdorff_to(global, c.input, tol) <= shape_bound;
+                                    test::hausdorff_to(global, c.input, tol) <= shape_bound;
                 if (rolled)
                     kept_without_sides += c.name + ", remove " + std::to_string(remove) +
                                           ", seed " + std::to_string(seed) + "; ";
@@ -308,8 +301,9 @@ TEST_CASE("untangle with sides inferred per region keeps a roll (no original at 
                 }
                 require_roll_kept(c, tangled, out, sides);
                 const double tol = 1e-6 * c.gap;
-                CHECK(hausdorff_to(out, c.input, tol) <=
-                      hausdorff_to(tangled, c.input, tol) + (remove < 0.92 ? 2.0 : 10.0) * c.gap);
+                CHECK(test::hausdorff_to(out, c.input, tol) <=
+                      test::hausdorff_to(tangled, c.input, tol) +
+                          (remove < 0.92 ? 2.0 : 10.0) * c.gap);
             }
     }
     INFO(cut << " of " << runs << " with the bend cut across the other layer");

@@ -1,5 +1,7 @@
 #include "support/fixtures.h"
 
+#include "strata/geometry/hausdorff.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -116,6 +118,13 @@ CheckReport check_against(const Scene& out, const Scene& original, const InputSi
     judged.input_sides = sides;
     judged.separation_tolerance = 0.1;
     return check_scene(out, judged);
+}
+
+double hausdorff_to(const Scene& a, const Scene& b, double tolerance) {
+    double h = 0.0;
+    for (std::size_t l = 0; l < a.size(); ++l)
+        h = std::max(h, hausdorff(a.layer(l), b.layer(l), tolerance).symmetric());
+    return h;
 }
 
 CheckReport check_by_original(const Scene& out, const Scene& original) {

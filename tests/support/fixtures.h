@@ -96,6 +96,10 @@ CheckReport check_against(const Scene& out, const Scene& original,
 /// (InputSides::matched()).
 CheckReport check_by_original(const Scene& out, const Scene& original);
 
+/// The largest per-layer symmetric Hausdorff distance between scenes `a` and `b` (layers
+/// matched by index), to within `tolerance` (scene units, > 0).
+double hausdorff_to(const Scene& a, const Scene& b, double tolerance);
+
 /// tests/data/<name>
 std::filesystem::path test_data(const std::string& name);
 /// ../shared/data/<name> beside the project, or empty when that folder is absent.

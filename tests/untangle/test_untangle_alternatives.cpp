@@ -3,7 +3,6 @@
 // clean (issues 13 and 19): a roll whose bend the decimation cut across the other layer.
 
 #include "strata/geometry/checks.h"
-#include "strata/geometry/hausdorff.h"
 #include "strata/geometry/input_sides.h"
 #include "strata/simplify/scene_families.h"
 #include "strata/simplify/simplify.h"
@@ -748,18 +747,6 @@ TEST_CASE(
     CHECK(test::check_by_original(unrolled, input).nesting_violation_count > 0);
 }
 
-namespace {
-
-// The largest per-layer Hausdorff distance of `scene` to `original` (layers matched by index).
-double farthest_layer(const Scene& scene, const Scene& original) {
-    double far = 0.0;
-    for (std::size_t i = 0; i < scene.size(); ++i)
-        far = std::max(far, hausdorff(scene.layer(i), original.layer(i), 1e-6).symmetric());
-    return far;
-}
-
-}  // namespace
-
 TEST_CASE(
     "untangle_inferring_sides: once more with the closed layers stiffer, the result that "
     "moves less",
@@ -771,7 +758,7 @@ TEST_CASE(
     const Scene input = make_scene(SceneFamily::ShirtRoll);
     const Scene tangled = naive_decimation(input, 0.95, 68);
     REQUIRE(check_scene(tangled).crossing_count > 0);
-    const double tangled_far = farthest_layer(tangled, input);
+    const double tangled_far = test::hausdorff_to(tangled, input, 1e-6);
 
     UntangleParams stiffer;
     stiffer.stiffer_closed = 4.0;
@@ -782,7 +769,7 @@ TEST_CASE(
     const CheckReport c = test::check_by_original(out, input);
     CHECK(c.is_collision_free());
     CHECK(c.separations_hold());
-    CHECK(farthest_layer(out, input) < 2.0 * tangled_far);
+    CHECK(test::hausdorff_to(out, input, 1e-6) < 2.0 * tangled_far);
     for (std::size_t i = 0; i < out.size(); ++i)  // the weights given are kept
         CHECK(out.layer(i).weight == tangled.layer(i).weight);
 
@@ -790,6 +777,6 @@ TEST_CASE(
     const UntangleReport before = untangle_inferring_sides(caved);
     CHECK(before.collision_free);
     CHECK_FALSE(before.stiffer_closed);
-    CHECK(farthest_layer(caved, input) > 2.0 * tangled_far);
+    CHECK(test::hausdorff_to(caved, input, 1e-6) > 2.0 * tangled_far);
     CHECK(report.max_displacement < before.max_displacement);
 }
