@@ -901,13 +901,13 @@ double mean_displacement(const Scene& result, const Scene& input) {
 UntangleReport untangle_inferring_sides(Scene& scene, const UntangleParams& params,
                                         const ProgressFn& given, InputSides* kept) {
     const ProgressFn progress = numbering_tries(given);
+    if (params.input_sides || !(params.stiffer_closed > 1.0) || !has_closed_and_open(scene))
+        return inferring_sides_call(scene, params, progress, kept);
     const Scene input = scene;
     InputSides sides;
     const UntangleReport first = inferring_sides_call(scene, params, progress, &sides);
     if (kept && !sides.empty()) *kept = sides;
-    if (!first.collision_free || params.input_sides || !(params.stiffer_closed > 1.0) ||
-        !has_closed_and_open(input))
-        return first;
+    if (!first.collision_free) return first;
     // Without an original, a clean result: untangle()'s tries once more from the input by the
     // sides it kept (the same reading), with the closed layers stiffer (UntangleParams::
     // stiffer_closed); kept when clean and its vertices moved less on average.
