@@ -1,0 +1,20 @@
+#pragma once
+/// @file Untwisting: the self-crossings of a scene taken out one vertex move at a time. The
+/// projection and the finishing stage never take a self-crossing out (docs/untangle.md); this
+/// is the last resorts' way (UntangleParams::untwist), before one more try from the untwisted
+/// result. Internal to the untangle module.
+
+#include "strata/geometry/scene.h"
+
+namespace strata::detail {
+
+/// Takes the self-crossings out of `scene` one vertex move at a time: for each self-crossing
+/// of segments s and t of a layer, each end vertex of either may move straight across the
+/// other's line to its far side, the layer's thickness beyond it; of the moves that leave the
+/// vertex's two segments meeting fewer segments of their layer and no more of other layers
+/// (exact), the shortest is made, until none is left or 4 moves per self-crossing of the
+/// input, plus 4, are made. True when none is left; false otherwise (no such move left, or the
+/// moves ran out), `scene` then holding the moves made.
+bool untwist(Scene& scene);
+
+}  // namespace strata::detail
