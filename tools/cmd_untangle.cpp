@@ -201,6 +201,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"untwisted", r.untwisted},
                 {"restarted", r.restarted},
                 {"ends_by_nearest", r.ends_by_nearest},
+                {"short_edges", r.short_edges},
                 {"end_sides_dropped", r.end_sides_dropped},
                 {"stiffer_closed", r.stiffer_closed},
                 {"input_kept", r.input_kept},

@@ -210,6 +210,11 @@ void validate(const UntangleParams& params) {
     if (!(params.step > 0.0 && params.step <= 1.0)) fail("step", params.step, "in (0, 1]");
     if (!(params.max_step_fraction > 0.0 && params.max_step_fraction <= 1.0))
         fail("max_step_fraction", params.max_step_fraction, "in (0, 1]");
+    if (!(params.short_edge_fraction >= 0.0) || !std::isfinite(params.short_edge_fraction))
+        fail("short_edge_fraction", params.short_edge_fraction, ">= 0 and finite");
+    if (!(params.retry_short_edge_fraction >= 0.0) ||
+        !std::isfinite(params.retry_short_edge_fraction))
+        fail("retry_short_edge_fraction", params.retry_short_edge_fraction, ">= 0 and finite");
     if (params.edge_samples < 0) fail("edge_samples", params.edge_samples, ">= 0");
     if (!(params.sample_spacing >= 0.0) || !std::isfinite(params.sample_spacing))
         fail("sample_spacing", params.sample_spacing, ">= 0 and finite");

@@ -597,6 +597,33 @@ UntangleReport with_ends_by_nearest(Scene& scene, const Scene& input, const Unta
     return done ? *done : cost.charged_to(failed);
 }
 
+// When `failed` (everything untangle_inferring_sides() tried from `input`, the last resorts
+// included; `scene` the result kept so far) is not clean, the last retry: from the input, by
+// params' own sides (the global order, or an original's), untangle()'s first and second tries
+// with UntangleParams::retry_short_edge_fraction for short_edge_fraction; the first clean
+// result is kept (report.short_edges). Their failed results are offered to no one: `scene` stays
+// the least tangled of the others. The report counts every try. Only a scene on which
+// everything failed gets here, so every clean output stays as it was.
+UntangleReport with_short_edges(Scene& scene, const Scene& input, const UntangleParams& given,
+                                const ProgressFn& progress, const UntangleReport& failed) {
+    if (failed.collision_free || !(given.retry_short_edge_fraction > given.short_edge_fraction))
+        return failed;
+    UntangleParams params = with_outside_sides(input, given);
+    params.short_edge_fraction = given.retry_short_edge_fraction;
+    TriesCost cost;
+    cost.add(failed);
+    LeastTangled not_offered(true);
+    std::optional<UntangleReport> done;
+    run_list(input, {TrySpec{&params, false}, TrySpec{&params, true}}, true, progress, not_offered,
+             &cost, [&](std::size_t, detail::TryResult&& r) {
+                 if (!r.report.collision_free) return;
+                 r.report.short_edges = true;
+                 scene = std::move(r.scene);
+                 done = cost.charged_to(r.report);
+             });
+    return done ? *done : cost.charged_to(failed);
+}
+
 // Vertex sides of `scene` that `every` gives and `kept` leaves out (once per other layer).
 std::size_t sides_left_out(const Scene& scene, const InputSides& every, const InputSides& kept) {
     std::size_t count = 0;
@@ -766,7 +793,7 @@ UntangleReport inferring_sides_call(Scene& scene, const UntangleParams& params,
             return inferring_sides_and_retries(scene, params, progress, kept, failures);
         },
         &tried);
-    if (report.collision_free || report.input_kept) return report;
+    if (report.collision_free) return report;
     // The sides the result kept was tried with: the inferred ones it kept, else params' own
     // (an original's, or the global order).
     UntangleParams p = with_outside_sides(input, params);
@@ -776,10 +803,11 @@ UntangleReport inferring_sides_call(Scene& scene, const UntangleParams& params,
     }
     try {
         UntangleReport last = report;
-        if (report.self_crossings_after > 0 && params.untwist)
+        if (!report.input_kept && report.self_crossings_after > 0 && params.untwist)
             last = untwisted_try(scene, input, p, report, progress);
-        if (last.collision_free || !params.restart) return last;
-        return restarted_tries(scene, input, p, last, progress);
+        if (!report.input_kept && !last.collision_free && params.restart)
+            last = restarted_tries(scene, input, p, last, progress);
+        return with_short_edges(scene, input, params, progress, last);
     } catch (...) {
         scene = input;
         throw;

@@ -309,4 +309,60 @@ TEST_CASE("bad untangle parameters are rejected by name", "[untangle]") {
     params = {};
     params.alpha = 2.0;
     CHECK_THROWS_WITH(untangle(scene, params), Catch::Contains("params.alpha"));
+    params = {};
+    params.short_edge_fraction = -0.1;
+    CHECK_THROWS_WITH(untangle(scene, params), Catch::Contains("params.short_edge_fraction"));
+}
+
+TEST_CASE("nearly coincident vertices do not hold each other still", "[untangle][slices]") {
+    // A slice of the Codim-IPC skirt at 0.69 m: the tip of a thin closed band (two vertices
+    // 3.6e-5 m apart, the median segment 3.3e-3 m) pokes into the next tier's loop, side by
+    // side, about 1e-3 m deep. Bounded by their 3.6e-5 m edge (UntangleParams::
+    // short_edge_fraction 0, the default), the tip's steps cannot get it out; past that edge
+    // they do.
+    const Scene input = read_scene_json(test::test_data("cipc_multilayer_y+0.69.json"));
+    REQUIRE(check_scene(input).crossing_count == 2);
+    Scene held = input;
+    CHECK_FALSE(untangle(held).collision_free);
+
+    UntangleParams passed;
+    passed.short_edge_fraction = 0.1;
+    Scene scene = input;
+    const UntangleReport report = untangle(scene, passed);
+    CHECK(report.collision_free);
+    const CheckReport after = check_scene(scene);
+    CHECK(after.crossing_count == 0);
+    CHECK(after.total_self_crossings() == 0);
+    CHECK(after.nesting_violation_count == 0);
+    // Only the tip moves far: no vertex by more than a few times the poke's depth.
+    CHECK(report.max_displacement < 0.005);
+}
+
+TEST_CASE("untangle_inferring_sides: the short edges passed when everything else fails",
+          "[untangle][slices]") {
+    // The same slice: every try fails with the default short_edge_fraction (0); the last retry
+    // passes the short edges (retry_short_edge_fraction). The other retries and last resorts
+    // are off here to keep the test short: they fail on this slice too (19 tries).
+    const Scene input = read_scene_json(test::test_data("cipc_multilayer_y+0.69.json"));
+    UntangleParams params;
+    params.other_readings = 0;
+    params.long_rounds_factor = 1;
+    params.retry_passes_factor = 1.0;
+    params.more_passes_factor = 1;
+    params.retry_ends_by_nearest = params.loop_readings = false;
+    params.untwist = params.restart = false;
+    UntangleParams without = params;
+    without.retry_short_edge_fraction = 0.0;
+    Scene failed = input;
+    const UntangleReport before = untangle_inferring_sides(failed, without);
+    CHECK_FALSE(before.collision_free);
+    CHECK_FALSE(before.short_edges);
+
+    Scene scene = input;
+    const UntangleReport report = untangle_inferring_sides(scene, params);
+    CHECK(report.collision_free);
+    CHECK(report.short_edges);
+    CHECK(report.tries == before.tries + 1);
+    CHECK(check_scene(scene).is_collision_free());
+    CHECK(report.crossings_before == 2);
 }

@@ -29,6 +29,7 @@ UntangleParams without_last_resorts() {
     params.loop_readings = false;
     params.untwist = false;
     params.restart = false;
+    params.retry_short_edge_fraction = 0.0;  // the retry after the last resorts
     return params;
 }
 

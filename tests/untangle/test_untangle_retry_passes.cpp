@@ -26,6 +26,7 @@ TEST_CASE("untangle_inferring_sides: every try once more with more passes when a
     params.more_passes_factor = 1;
     params.other_readings = 0;
     params.loop_readings = params.untwist = params.restart = false;  // the retry alone
+    params.retry_short_edge_fraction = 0.0;
     UntangleParams without = params;
     without.retry_passes_factor = 1.0;
     without.retry_ends_by_nearest = false;  // which cleans it too, after every retry

@@ -29,6 +29,13 @@ struct UntangleParams {
     double step = 0.5;        ///< dt: damping of each normalised projection step, (0, 1].
     /// Each vertex step is clamped to this fraction of the shorter adjacent edge. (0, 1].
     double max_step_fraction = 0.25;
+    /// An edge shorter than this fraction of the median segment length (of the layers being
+    /// untangled, at the start of each pass) does not bound the steps of its vertices
+    /// (max_step_fraction): the bound reaches past it, to the first vertex along the layer at
+    /// least that far away (at most 8 edges on). Nearly coincident vertices (a slice of a mesh
+    /// cut close to its vertices) would otherwise hold each other still. 0: every adjacent
+    /// edge bounds. >= 0, finite. docs/untangle.md, "Short edges".
+    double short_edge_fraction = 0.0;
     /// Interior points tested on each edge, at least (1 = the midpoint): a chord between two
     /// good vertices can still cut a neighbour. >= 0.
     int edge_samples = 1;
@@ -136,6 +143,11 @@ struct UntangleParams {
     /// first try, then the second (no self-crossing made). false: no such retry.
     /// docs/untangle.md, "Ends read by the nearest feature".
     bool retry_ends_by_nearest = true;
+    /// untangle_inferring_sides() only: when everything else has failed, the last resorts
+    /// included, untangle()'s first and second tries once more from the input, by params' own
+    /// sides, with short_edge_fraction at this value; the first clean result is kept
+    /// (report.short_edges). Not above short_edge_fraction: no such retry. >= 0, finite.
+    double retry_short_edge_fraction = 0.1;
     /// untangle_inferring_sides() without params.input_sides only, on a scene with both closed
     /// and open layers, when the call comes out clean: untangle()'s tries once more from the
     /// input by the sides the result kept (the same reading), with every closed layer's weight
@@ -268,6 +280,9 @@ struct UntangleReport {
     /// untangle_inferring_sides(): every try failed, and the result is one of the last retry,
     /// with the ends read by the nearest feature (UntangleParams::retry_ends_by_nearest).
     bool ends_by_nearest = false;
+    /// untangle_inferring_sides(): everything else failed, and the result is one of the tries
+    /// with the short edges passed (UntangleParams::retry_short_edge_fraction).
+    bool short_edges = false;
     /// untangle(), untangle_inferring_sides(): no try came out clean and none was less tangled
     /// than the input, which is the result, unchanged (moved_vertices 0; the counts after are
     /// the input's). When every try fails, the result kept is the least tangled of theirs and
@@ -326,7 +341,9 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// feature (params.retry_ends_by_nearest, report.ends_by_nearest); without an original, the
 /// loop readings (params.loop_readings); then, with or without, the least tangled result's
 /// self-crossings untwisted and one more try from there (params.untwist), then untangle()'s
-/// tries once more from that result (params.restart), each kept when clean. When every try
+/// tries once more from that result (params.restart), each kept when clean; then, from the
+/// input, params' own sides' first and second tries with the short edges passed
+/// (params.retry_short_edge_fraction, report.short_edges). When every try
 /// fails, the result is the least tangled of all their results and the input, as untangle()
 /// orders them, each try judged by the sides it untangled toward (report.inferred_sides and
 /// sides_reading say which). Once a try has failed, the tries of a list that all start from

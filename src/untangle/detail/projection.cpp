@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <tuple>
@@ -230,6 +231,18 @@ struct Scratch {
     std::vector<CompositionConstraint> constraints;
 };
 
+// The upper median of the segment lengths of `scene` (0 for none).
+double upper_median_segment(const Scene& scene) {
+    std::vector<double> lengths;
+    for (const Layer& layer : scene.layers())
+        for (std::size_t i = 0; i < layer.segment_count(); ++i)
+            lengths.push_back(glm::distance(layer.segment_start(i), layer.segment_end(i)));
+    if (lengths.empty()) return 0.0;
+    const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), middle, lengths.end());
+    return *middle;
+}
+
 }  // namespace
 
 // ProjectionPass's state and work (the class comment in projection.h).
@@ -241,6 +254,7 @@ class ProjectionPass::Impl {
           relations_(relations),
           params_(params),
           sample_spacing_(sample_spacing),
+          short_edge_(params.short_edge_fraction * upper_median_segment(work)),
           scratch_([&params] { return Scratch(params.composition); }) {
         double largest = 0.0;
         for (std::size_t a = 0; a < fields.size(); ++a)
@@ -537,12 +551,11 @@ class ProjectionPass::Impl {
                 if (!piece.is_free[k] || weight_[k] <= 0.0) continue;
                 const std::size_t v = piece.vertices[k];
                 Vec2 d = sum_[k] / weight_[k];
-                // Clamp to a fraction of the shorter adjacent edge.
+                // Clamp to a fraction of the shorter adjacent edge (past short edges).
                 double edge = std::numeric_limits<double>::infinity();
-                if (layer.closed || v > 0)
-                    edge = std::min(edge, glm::distance(x[v], x[(v + n - 1) % n]));
+                if (layer.closed || v > 0) edge = std::min(edge, step_edge(x, layer.closed, v, -1));
                 if (layer.closed || v + 1 < n)
-                    edge = std::min(edge, glm::distance(x[v], x[(v + 1) % n]));
+                    edge = std::min(edge, step_edge(x, layer.closed, v, +1));
                 const double limit = params_.max_step_fraction * edge;
                 const double len = glm::length(d);
                 if (len > limit) d *= limit / len;
@@ -553,6 +566,24 @@ class ProjectionPass::Impl {
             scene.set_points(piece.layer, std::move(next_));  // next_ is refilled before use
         }
         return moved;
+    }
+
+    // The length that bounds the step of vertex v of a layer (`x`, `closed`) on the side `dir`
+    // (-1: toward v - 1, +1: toward v + 1; a side that exists): its distance to the first
+    // vertex that way at least short_edge_ from it, at most kShortEdgeHops edges on (then to
+    // the last one reached, as at an open layer's end). With short_edge_ 0, the adjacent edge.
+    double step_edge(const std::vector<Vec2>& x, bool closed, std::size_t v, int dir) const {
+        constexpr int kShortEdgeHops = 8;
+        const std::size_t n = x.size();
+        double distance = 0.0;
+        std::size_t j = v;
+        for (int hop = 0; hop < kShortEdgeHops; ++hop) {
+            if (!closed && (dir < 0 ? j == 0 : j + 1 == n)) break;
+            j = dir < 0 ? (j + n - 1) % n : (j + 1) % n;
+            distance = glm::distance(x[v], x[j]);
+            if (distance >= short_edge_) break;
+        }
+        return distance;
     }
 
     // EngineSettings::keep_simple: the moves of `piece` from `before` to `after` taken one
@@ -623,6 +654,7 @@ class ProjectionPass::Impl {
     const RelationSource& relations_;
     const UntangleParams& params_;
     double sample_spacing_ = 0.0;
+    double short_edge_ = 0.0;  // UntangleParams::short_edge_fraction x the median segment
     double reach_ = 0.0;  // how far from an edge a vertex of another layer gets its own sample
     tbb::enumerable_thread_specific<Scratch> scratch_;
     VertexGrid grid_;
