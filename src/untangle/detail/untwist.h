@@ -1,8 +1,8 @@
 #pragma once
 /// @file Untwisting: the self-crossings of a scene taken out one vertex move at a time. The
-/// projection and the finishing stage never take a self-crossing out (docs/untangle.md); this
-/// is the last resorts' way (UntangleParams::untwist), before one more try from the untwisted
-/// result. Internal to the untangle module.
+/// projection and the finishing stage do not aim at self-crossings (docs/untangle.md, "A second
+/// try"); this is the last resorts' way (UntangleParams::untwist), before one more try from the
+/// untwisted result. Internal to the untangle module.
 
 #include "strata/geometry/scene.h"
 
