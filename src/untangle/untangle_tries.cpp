@@ -275,7 +275,7 @@ UntangleReport untangle_tries(Scene& scene, const UntangleParams& given, const P
     const UntangleParams params = with_outside_sides(scene, given);
     const Scene input = scene;
     // The first try, then a second from the input: no vertex move that makes a self-crossing
-    // (the projection and shape matching make them, and nothing takes them out:
+    // (the projection and shape matching make them, and nothing aims at taking them out:
     // docs/untangle.md). The first result is kept unless the second is clean.
     UntangleReport first;
     std::optional<detail::TryResult> second;
