@@ -254,7 +254,9 @@ class ProjectionPass::Impl {
           relations_(relations),
           params_(params),
           sample_spacing_(sample_spacing),
-          short_edge_(params.short_edge_fraction * upper_median_segment(work)),
+          short_edge_(params.short_edge_fraction > 0.0
+                          ? params.short_edge_fraction * upper_median_segment(work)
+                          : 0.0),
           scratch_([&params] { return Scratch(params.composition); }) {
         double largest = 0.0;
         for (std::size_t a = 0; a < fields.size(); ++a)
