@@ -40,15 +40,6 @@ std::vector<double> segment_lengths(const Layer& layer) {
     return lengths;
 }
 
-double median_segment_length(const Scene& scene) {
-    std::vector<double> lengths;
-    for (const Layer& layer : scene.layers()) {
-        const std::vector<double> l = segment_lengths(layer);
-        lengths.insert(lengths.end(), l.begin(), l.end());
-    }
-    return median(std::move(lengths));
-}
-
 double finest_layer_median(const Scene& scene) {
     double finest = std::numeric_limits<double>::infinity();
     for (const Layer& layer : scene.layers())
@@ -83,6 +74,15 @@ bool is_stalled(const std::vector<double>& worst, int passes, double allowed) {
 }
 
 }  // namespace
+
+double median_segment_length(const Scene& scene) {
+    std::vector<double> lengths;
+    for (const Layer& layer : scene.layers()) {
+        const std::vector<double> l = segment_lengths(layer);
+        lengths.insert(lengths.end(), l.begin(), l.end());
+    }
+    return median(std::move(lengths));
+}
 
 void take_input_sides(RelationSource& relations, const Scene& work, const InputSides& sides,
                       const std::vector<int>& outside_signs,

@@ -124,6 +124,10 @@ struct EngineResult {
     double seconds_finish = 0.0;
 };
 
+/// The upper median of the segment lengths of `scene`, zero-length ones included (0 for
+/// none): the scale of UntangleParams' automatic lengths.
+double median_segment_length(const Scene& scene);
+
 /// Resolves the automatic min_separation and sample_spacing from `scene` and the params, and
 /// the outside signs (params.outside_sides where given, else outside_side() of `scene`).
 EngineSettings resolve_settings(const Scene& scene, const UntangleParams& params);

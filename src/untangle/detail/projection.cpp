@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <tuple>
@@ -231,18 +230,6 @@ struct Scratch {
     std::vector<CompositionConstraint> constraints;
 };
 
-// The upper median of the segment lengths of `scene` (0 for none).
-double upper_median_segment(const Scene& scene) {
-    std::vector<double> lengths;
-    for (const Layer& layer : scene.layers())
-        for (std::size_t i = 0; i < layer.segment_count(); ++i)
-            lengths.push_back(glm::distance(layer.segment_start(i), layer.segment_end(i)));
-    if (lengths.empty()) return 0.0;
-    const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
-    std::nth_element(lengths.begin(), middle, lengths.end());
-    return *middle;
-}
-
 }  // namespace
 
 // ProjectionPass's state and work (the class comment in projection.h).
@@ -255,7 +242,7 @@ class ProjectionPass::Impl {
           params_(params),
           sample_spacing_(sample_spacing),
           short_edge_(params.short_edge_fraction > 0.0
-                          ? params.short_edge_fraction * upper_median_segment(work)
+                          ? params.short_edge_fraction * median_segment_length(work)
                           : 0.0),
           scratch_([&params] { return Scratch(params.composition); }) {
         double largest = 0.0;
