@@ -570,58 +570,62 @@ UntangleReport with_retry_passes(Scene& scene, const UntangleParams& params, All
     return after_retry(scene, report, std::move(attempt), second);
 }
 
+// One of the last retries of untangle_inferring_sides(), after `failed` (its tries from
+// `input`): from the input, by `params`' own sides (the global order, or an original's),
+// untangle()'s first and second tries (`ends_by_nearest`: EngineSettings'), each failed one
+// offered to `failures`; the first clean result is kept, its report's `mark` set. The report
+// counts `failed` and every try; it is failed's when neither comes out clean.
+UntangleReport own_sides_retry(Scene& scene, const Scene& input, const UntangleParams& params,
+                               bool ends_by_nearest, bool UntangleReport::*mark,
+                               const ProgressFn& progress, const UntangleReport& failed,
+                               LeastTangled& failures) {
+    TriesCost cost;
+    cost.add(failed);
+    std::optional<UntangleReport> done;
+    run_list(input,
+             {TrySpec{&params, false, nullptr, 0, ends_by_nearest},
+              TrySpec{&params, true, nullptr, 0, ends_by_nearest}},
+             true, progress, failures, &cost, [&](std::size_t, detail::TryResult&& r) {
+                 if (!r.report.collision_free) return;
+                 r.report.*mark = true;
+                 scene = std::move(r.scene);
+                 done = cost.charged_to(r.report);
+             });
+    return done ? *done : cost.charged_to(failed);
+}
+
 // When `failed` (every try of untangle_inferring_sides() from `input`) is not clean, the last
-// retry: from the input, by params' own sides (the global order, or an original's) with the
-// ends read by the nearest feature (EngineSettings::ends_by_nearest), untangle()'s first and
-// second tries; the first clean result is kept (report.ends_by_nearest). The report counts
-// every try. Only a scene every try failed on gets here, so every clean output stays as it was.
+// retry: own_sides_retry() with the ends read by the nearest feature
+// (EngineSettings::ends_by_nearest; report.ends_by_nearest). Only a scene every try failed on
+// gets here, so every clean output stays as it was.
 UntangleReport with_ends_by_nearest(Scene& scene, const Scene& input, const UntangleParams& given,
                                     const ProgressFn& progress, const UntangleReport& failed,
                                     LeastTangled& failures) {
     if (failed.collision_free || !given.retry_ends_by_nearest) return failed;
     const UntangleParams params = with_outside_sides(input, given);
-    TriesCost cost;
-    cost.add(failed);
     failures.long_rounds = failures.retry_passes = failures.more_passes = false;
     failures.ends_by_nearest = true;
-    std::optional<UntangleReport> done;
-    run_list(input,
-             {TrySpec{&params, false, nullptr, 0, true}, TrySpec{&params, true, nullptr, 0, true}},
-             true, progress, failures, &cost, [&](std::size_t, detail::TryResult&& r) {
-                 if (!r.report.collision_free) return;
-                 r.report.ends_by_nearest = true;
-                 scene = std::move(r.scene);
-                 done = cost.charged_to(r.report);
-             });
+    const UntangleReport report = own_sides_retry(
+        scene, input, params, true, &UntangleReport::ends_by_nearest, progress, failed, failures);
     failures.ends_by_nearest = false;
-    return done ? *done : cost.charged_to(failed);
+    return report;
 }
 
 // When `failed` (everything untangle_inferring_sides() tried from `input`, the last resorts
-// included; `scene` the result kept so far) is not clean, the last retry: from the input, by
-// params' own sides (the global order, or an original's), untangle()'s first and second tries
-// with UntangleParams::retry_short_edge_fraction for short_edge_fraction; the first clean
-// result is kept (report.short_edges). Their failed results are offered to no one: `scene` stays
-// the least tangled of the others. The report counts every try. Only a scene on which
-// everything failed gets here, so every clean output stays as it was.
+// included; `scene` the result kept so far) is not clean, the last retry: own_sides_retry()
+// with UntangleParams::retry_short_edge_fraction for short_edge_fraction
+// (report.short_edges). Its failed results are offered to no one: `scene` stays the least
+// tangled of the others. Only a scene on which everything failed gets here, so every clean
+// output stays as it was.
 UntangleReport with_short_edges(Scene& scene, const Scene& input, const UntangleParams& given,
                                 const ProgressFn& progress, const UntangleReport& failed) {
     if (failed.collision_free || !(given.retry_short_edge_fraction > given.short_edge_fraction))
         return failed;
     UntangleParams params = with_outside_sides(input, given);
     params.short_edge_fraction = given.retry_short_edge_fraction;
-    TriesCost cost;
-    cost.add(failed);
     LeastTangled not_offered(true);
-    std::optional<UntangleReport> done;
-    run_list(input, {TrySpec{&params, false}, TrySpec{&params, true}}, true, progress, not_offered,
-             &cost, [&](std::size_t, detail::TryResult&& r) {
-                 if (!r.report.collision_free) return;
-                 r.report.short_edges = true;
-                 scene = std::move(r.scene);
-                 done = cost.charged_to(r.report);
-             });
-    return done ? *done : cost.charged_to(failed);
+    return own_sides_retry(scene, input, params, false, &UntangleReport::short_edges, progress,
+                           failed, not_offered);
 }
 
 // Vertex sides of `scene` that `every` gives and `kept` leaves out (once per other layer).
