@@ -23,6 +23,18 @@ step=${2:-0.1}
 offset=${3:-0}
 limit=${TIME_LIMIT:-300}
 read -ra untangle_args <<<"${UNTANGLE_ARGS:-}"
+# is_number VALUE [positive]: exit 0 when VALUE is a finite number (> 0 with "positive").
+is_number() {
+  python3 -c '
+import math, sys
+try:
+    v = float(sys.argv[1])
+except ValueError:
+    sys.exit(1)
+sys.exit(0 if math.isfinite(v) and (len(sys.argv) < 3 or v > 0) else 1)' "$@"
+}
+is_number "$step" positive || { echo "$0: STEP must be a number > 0 (got '$step')" >&2; exit 2; }
+is_number "$offset" || { echo "$0: OFFSET must be a number (got '$offset')" >&2; exit 2; }
 [ -x "$strata" ] || { echo "$0: no strata binary at $strata" >&2; exit 2; }
 [ -d "$data" ] || { echo "$0: no garments folder at $data" >&2; exit 2; }
 mkdir -p "$out"
