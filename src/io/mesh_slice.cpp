@@ -1071,11 +1071,18 @@ NestingReport nest_layers(std::vector<Layer>& layers, const std::vector<int>& ra
             ++report.side_conflicts;
             continue;
         }
-        double evidence = 0.0;
+        double from_a = 0.0, from_b = 0.0;
         if (const int s = sign_of(p.ba.side); s != 0 && use_a)
-            evidence += (s == -inner[p.a] ? 1.0 : -1.0) * std::abs(p.ba.side);
+            from_a = (s == -inner[p.a] ? 1.0 : -1.0) * std::abs(p.ba.side);
         if (const int s = sign_of(p.ab.side); s != 0 && use_b)
-            evidence += (s == inner[p.b] ? 1.0 : -1.0) * std::abs(p.ab.side);
+            from_b = (s == inner[p.b] ? 1.0 : -1.0) * std::abs(p.ab.side);
+        // Each on the other's outer side, or each on the other's inner side: neither order
+        // agrees with both (a guessed side may be wrong, but which one is not known).
+        if (from_a * from_b < 0.0) {
+            ++report.side_conflicts;
+            continue;
+        }
+        const double evidence = from_a + from_b;
         if (evidence > 0.0) {
             links.push_back({p.a, p.b, strength});
         } else if (evidence < 0.0) {
@@ -1093,9 +1100,34 @@ NestingReport nest_layers(std::vector<Layer>& layers, const std::vector<int>& ra
         return x.strength > y.strength;
     });
     std::vector<std::vector<std::size_t>> out(n);
+    // inside[x * n + y]: the share of x's length inside closed y (-1: not measured yet).
+    std::vector<double> inside(n * n, -1.0);
+    auto inside_share = [&](std::size_t x, std::size_t y) {
+        double& share = inside[x * n + y];
+        if (share < 0.0) share = measure(layers[x], weights[x], index[y], d).inside;
+        return share;
+    };
+    // Would `c` put a layer under a loop that it mostly lies outside of (c.under, or a layer
+    // under it, under c.over or a closed layer over it)? A chain of open layers can imply it
+    // where no pair of the chain says so (an armpit, where the pieces cross).
+    auto outside_a_loop = [&](const Candidate& c) {
+        std::vector<std::size_t> loops;
+        for (std::size_t y = 0; y < n; ++y)
+            if (layers[y].closed && (y == c.over || reaches(out, c.over, y))) loops.push_back(y);
+        for (std::size_t x = 0; x < n && !loops.empty(); ++x) {
+            if (x != c.under && !reaches(out, x, c.under)) continue;
+            for (std::size_t y : loops)
+                if (inside_share(x, y) < 0.5) return true;
+        }
+        return false;
+    };
     for (const Candidate& c : links) {
         if (reaches(out, c.over, c.under)) {
             ++report.dropped_for_cycles;
+            continue;
+        }
+        if (outside_a_loop(c)) {
+            ++report.dropped_outside_loops;
             continue;
         }
         out[c.under].push_back(c.over);

@@ -187,8 +187,12 @@ struct NestingReport {
     std::size_t links = 0;               ///< Direct `outer` links written (transitive reduction).
     std::size_t candidate_links = 0;     ///< Relations found before the reduction.
     std::size_t dropped_for_cycles = 0;  ///< Relations dropped because they closed a cycle.
+    /// Relations dropped because, with those kept before, they put a layer under a closed one
+    /// that it mostly lies outside of.
+    std::size_t dropped_outside_loops = 0;
     /// Pairs near enough to relate but left side by side: a loop on an open layer's outer
-    /// side, or two open layers not each on one side of the other (one wraps around an end).
+    /// side; two open layers not each on one side of the other (one wraps around an end), or
+    /// each on the other's outer side (or each on the other's inner side).
     std::size_t side_conflicts = 0;
     std::size_t order_decisions = 0;  ///< Relations decided by `rank` where geometry was even.
 };
@@ -203,9 +207,11 @@ struct NestingReport {
 ///   the loop is on the open layer's inner side (the side most of its near loops are on; with
 ///   no such loop, the inside of the polygon closed by its chord).
 /// - open / open: stacked only when they run alongside; the one on the outer side of the
-///   other is over it. Pieces that merely meet end to end stay side by side.
-/// Relations are added strongest first, skipping any that would close a cycle; only the
-/// transitive reduction is written.
+///   other is over it. Pieces that merely meet end to end, or that each lie on the other's
+///   outer side (or each on the other's inner side), stay side by side.
+/// Relations are added strongest first, skipping any that would close a cycle or put a layer
+/// (directly or through others) under a loop it mostly lies outside of; only the transitive
+/// reduction is written.
 /// @param layers  modified in place (only `outer`); names must be unique.
 /// @param rank    optional, one per layer: position of its mesh in a user-given order
 ///                (smaller = further inside, < 0 = unknown); breaks geometric ties.
