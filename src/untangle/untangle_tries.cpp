@@ -807,7 +807,7 @@ UntangleReport inferring_sides_call(Scene& scene, const UntangleParams& params,
     }
     try {
         UntangleReport last = report;
-        if (!report.input_kept && report.self_crossings_after > 0 && params.untwist)
+        if (report.self_crossings_after > 0 && params.untwist)
             last = untwisted_try(scene, input, p, report, progress);
         if (!report.input_kept && !last.collision_free && params.restart)
             last = restarted_tries(scene, input, p, last, progress);

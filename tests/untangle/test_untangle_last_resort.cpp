@@ -14,6 +14,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <utility>
 
 using namespace strata;
@@ -71,6 +72,37 @@ TEST_CASE("untangle_inferring_sides: the least tangled result untwisted when eve
         test::check_by_original(out, make_scene(SceneFamily::ShirtRoll, {}));
     CHECK(against.is_collision_free());
     CHECK(against.separations_hold());
+}
+
+TEST_CASE("untangle_inferring_sides: an input no try improves on is untwisted too", "[untangle]") {
+    // A loop pinched at a point it passes twice (a slice through a saddle vertex of its mesh:
+    // the body at x = 2.5 dm), inside another: no crossing between layers, one self-touch that
+    // no try takes out. Every try ties with the input, which is kept; untwisting it (a vertex
+    // moved off the other strand by a hair) and one more try from there is clean.
+    Layer pinched;
+    pinched.name = "pinched";
+    pinched.points = {{0, 0}, {1, 1}, {2, 0}, {1, -1}, {0, 0}, {-1, -1}, {-2, 0}, {-1, 1}};
+    pinched.closed = true;
+    Layer around;
+    around.name = "around";
+    for (int k = 0; k < 32; ++k)
+        around.points.emplace_back(4.0 * std::cos(k * M_PI / 16.0),
+                                   4.0 * std::sin(k * M_PI / 16.0));
+    around.closed = true;
+    const Scene tangled({pinched, around});
+    REQUIRE(check_scene(tangled).crossing_count == 0);
+    REQUIRE(check_scene(tangled).total_self_crossings() == 1);
+    Scene out;
+    const auto [before, report] =
+        without_then_with(tangled, without_last_resorts(), &UntangleParams::untwist, out);
+    CHECK_FALSE(before.collision_free);
+    CHECK(before.input_kept);
+    CHECK(report.collision_free);
+    CHECK(report.untwisted);
+    CHECK(report.max_displacement < 1e-6);
+    const CheckReport c = check_scene(out);
+    CHECK(c.crossing_count == 0);
+    CHECK(c.total_self_crossings() == 0);
 }
 
 TEST_CASE("untangle_inferring_sides: a small loop read on both sides of a layer read on one",

@@ -65,6 +65,26 @@ TEST_CASE("untwist: a loop with two vertices swapped loses its twist by one vert
     CHECK(scene.layer(1).points == before.layer(1).points);
 }
 
+TEST_CASE("untwist: a loop pinched at a repeated point comes apart by a tiny move", "[untwist]") {
+    // Two lobes that meet at the origin, which the loop passes twice (a slice through a
+    // saddle vertex of its mesh: the body at x = 2.5 dm): the strands touch there without
+    // crossing, each vertex on the other's line, so no move across a line exists.
+    const std::vector<Vec2> pinched = {{0, 0}, {1, 1},   {2, 0},  {1, -1},
+                                       {0, 0}, {-1, -1}, {-2, 0}, {-1, 1}};
+    std::vector<Vec2> around = circle(32, 4.0);
+    Scene scene({loop("pinched", pinched), loop("around", around)});
+    const Scene before = scene;
+    REQUIRE(check_scene(before).total_self_crossings() == 1);
+
+    REQUIRE(detail::untwist(scene));
+    const CheckReport after = check_scene(scene);
+    CHECK(after.total_self_crossings() == 0);
+    CHECK(after.crossing_count == 0);
+    CHECK(moved(before, scene) <= 2);  // the two copies of the pinch point at most
+    for (std::size_t v = 0; v < pinched.size(); ++v)
+        CHECK(glm::length(scene.layer(0).points[v] - pinched[v]) < 1e-6);
+}
+
 TEST_CASE("untwist: no move that crosses another layer", "[untwist]") {
     // The same twist with a small loop put where the move above took the vertex: that move
     // would now cross it, so another one is made, or none.

@@ -96,10 +96,11 @@ struct UntangleParams {
     /// (a small closed loop read on both sides of an open layer, all on one side), each as a
     /// first try then as a second try; the first clean result is kept (report.loop_reading).
     bool loop_readings = true;
-    /// untangle_inferring_sides(), when every try has failed and the least tangled result has
-    /// self-crossings (which neither the projection nor the finishing stage takes out): each
-    /// moved by one vertex straight across the other segment's line (the shortest such move
-    /// that leaves fewer segments of the layer met and no more of other layers), then one more
+    /// untangle_inferring_sides(), when every try has failed and the least tangled result (the
+    /// input, when no try was less tangled) has self-crossings (which neither the projection
+    /// nor the finishing stage takes out): each moved by one vertex straight across the other
+    /// segment's line, or off it when on it (the shortest such move that leaves fewer segments
+    /// of the layer met and no more of other layers), then one more
     /// try from there by the same sides, with no self-crossing made; kept when clean
     /// (report.untwisted).
     bool untwist = true;
