@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -77,21 +78,21 @@ bool untwist(Scene& scene) {
                 for (const std::size_t v : {mine, (mine + 1) % n}) {
                     const Vec2 p = layer.points[v];
                     const double d = glm::dot(p - q0, normal);
-                    // Across the line to its far side; a vertex on the line (a touch, e.g. a
-                    // slice through a saddle vertex of its mesh) off it to either side.
                     const double move = std::abs(d) + aim;
                     if (!(move < shortest)) continue;
-                    for (const double side : {1.0, -1.0}) {
-                        if (d != 0.0 && side < 0.0) break;
-                        const Vec2 at = d != 0.0 ? p - (d + (d > 0.0 ? aim : -aim)) * normal
-                                                 : p + side * aim * normal;
-                        const auto before = segments_met(scene, c.layer_a, v, p);
-                        const auto after = segments_met(scene, c.layer_a, v, at);
+                    // Across the line to its far side; a vertex on the line (a touch, e.g. a
+                    // slice through a saddle vertex of its mesh) off it, to either side.
+                    const Vec2 across = p - (d + std::copysign(aim, d)) * normal;
+                    const std::array<Vec2, 2> targets = {d != 0.0 ? across : p + aim * normal,
+                                                         p - aim * normal};
+                    const auto before = segments_met(scene, c.layer_a, v, p);
+                    for (std::size_t k = 0; k < (d != 0.0 ? 1u : 2u); ++k) {
+                        const auto after = segments_met(scene, c.layer_a, v, targets[k]);
                         if (after.second >= before.second || after.first > before.first) continue;
                         shortest = move;
                         best_layer = c.layer_a;
                         best_vertex = v;
-                        best_at = at;
+                        best_at = targets[k];
                         break;
                     }
                 }

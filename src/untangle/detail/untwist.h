@@ -10,11 +10,10 @@ namespace strata::detail {
 
 /// Takes the self-crossings out of `scene` one vertex move at a time: for each self-crossing
 /// of segments s and t of a layer, each end vertex of either may move straight across the
-/// other's line to its far side, the layer's thickness beyond it (1e-9 of the scene's diagonal
-/// at thickness 0), or, on that line (a touch), off it to either side by as much; of the moves
-/// that leave the
-/// vertex's two segments meeting fewer segments of their layer and no more of other layers
-/// (exact), the shortest is made, until none is left or 4 moves per self-crossing of the
+/// other's line to its far side, the layer's thickness beyond it (at least 1e-9 of the scene's
+/// diagonal), or, on that line (a touch), off it to either side by as much; of the moves that
+/// leave the vertex's two segments meeting fewer segments of their layer and no more of other
+/// layers (exact), the shortest is made, until none is left or 4 moves per self-crossing of the
 /// input, plus 4, are made. True when none is left; false otherwise (no such move left, or the
 /// moves ran out), `scene` then holding the moves made.
 bool untwist(Scene& scene);
