@@ -746,10 +746,10 @@ TEST_CASE("welding: ends far apart stay apart; the tolerance is overridable",
 
 TEST_CASE("real garments: the armpit slices' nesting holds where the input crosses",
           "[mesh_slice][slow]") {
-    // casualsuit05 at the armpits: the suit's pieces cross one another. Links from pieces
-    // each on the other's outer side (a near tie of guessed sides) and chains putting the
-    // body under a piece it lies outside of left 7, 10, 16 and 26 vertices on the wrong side
-    // at these heights; the input's only faults are now its crossings.
+    // casualsuit05 at the armpits: the suit's pieces cross one another. Links between pieces
+    // each on the other's outer side (near ties of sides guessed from their chords), chained
+    // with others, put layers under pieces they lie outside of: 7, 10, 16 and 26 vertices on
+    // the wrong side at these heights. The input's only faults are now its crossings.
     const auto body_path = test::shared_data("garments/makehuman/male_generic.obj");
     if (body_path.empty()) {
         WARN("../shared/data absent: skipped");
