@@ -999,6 +999,9 @@ NestingReport nest_layers(std::vector<Layer>& layers, const std::vector<int>& ra
         OneWay ab, ba;     // a measured against b, b against a
     };
     std::vector<Pending> pending;
+    // inside[a * n + b]: the share of a's length inside b when b is closed (0 for a pair too far
+    // apart to be measured: their boxes do not meet).
+    std::vector<double> inside(n * n, 0.0);
     for (std::size_t a = 0; a < n; ++a)
         for (std::size_t b = a + 1; b < n; ++b) {
             const Layer &la = layers[a], &lb = layers[b];
@@ -1007,6 +1010,8 @@ NestingReport nest_layers(std::vector<Layer>& layers, const std::vector<int>& ra
             if (!may_contain && !index[a].box().inflated(d).overlaps(index[b].box())) continue;
             const OneWay ab = measure(la, weights[a], index[b], d);
             const OneWay ba = measure(lb, weights[b], index[a], d);
+            inside[a * n + b] = ab.inside;
+            inside[b * n + a] = ba.inside;
             const bool alongside = ab.near >= theta || ba.near >= theta;
             if (la.closed && lb.closed) {
                 const bool a_in = ab.inside >= 0.5, b_in = ba.inside >= 0.5;
@@ -1100,13 +1105,6 @@ NestingReport nest_layers(std::vector<Layer>& layers, const std::vector<int>& ra
         return x.strength > y.strength;
     });
     std::vector<std::vector<std::size_t>> out(n);
-    // inside[x * n + y]: the share of x's length inside closed y (-1: not measured yet).
-    std::vector<double> inside(n * n, -1.0);
-    auto inside_share = [&](std::size_t x, std::size_t y) {
-        double& share = inside[x * n + y];
-        if (share < 0.0) share = measure(layers[x], weights[x], index[y], d).inside;
-        return share;
-    };
     // Would `c` put a layer under a loop that it mostly lies outside of (c.under, or a layer
     // under it, under c.over or a closed layer over it)? A chain of open layers can imply it
     // where no pair of the chain says so (an armpit, where the pieces cross).
@@ -1117,7 +1115,7 @@ NestingReport nest_layers(std::vector<Layer>& layers, const std::vector<int>& ra
         for (std::size_t x = 0; x < n && !loops.empty(); ++x) {
             if (x != c.under && !reaches(out, x, c.under)) continue;
             for (std::size_t y : loops)
-                if (inside_share(x, y) < 0.5) return true;
+                if (inside[x * n + y] < 0.5) return true;
         }
         return false;
     };
