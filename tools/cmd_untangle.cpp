@@ -199,6 +199,7 @@ Run add_untangle_command(CLI::App& app) {
                 {"more_passes", r.more_passes},
                 {"loop_reading", r.loop_reading},
                 {"untwisted", r.untwisted},
+                {"ends_retracted", r.ends_retracted},
                 {"restarted", r.restarted},
                 {"ends_by_nearest", r.ends_by_nearest},
                 {"short_edges", r.short_edges},
@@ -258,11 +259,17 @@ Run add_untangle_command(CLI::App& app) {
                                                            short_number(params.stiffer_closed) +
                                                            "x stiffer: it moved the vertices less)"
                                                      : "";
+        // A last resort that shortens layers: say so (UntangleReport::ends_retracted).
+        const std::string retracted =
+            r.ends_retracted > 0 ? " (" + std::to_string(r.ends_retracted) +
+                                       (r.ends_retracted == 1 ? " end" : " ends") +
+                                       " of open layers moved back along their end segments)"
+                                 : "";
         std::printf(
             "min separation ratio after: %.4g; moved vertices: %zu of %zu; max displacement: "
-            "%.4g%s\n",
+            "%.4g%s%s\n",
             r.min_separation_ratio_after, r.moved_vertices, r.free_vertices, r.max_displacement,
-            stiffer.c_str());
+            stiffer.c_str(), retracted.c_str());
         // Every try failed: the result is the least tangled of theirs, or the input.
         const char* kept = r.collision_free ? ""
                            : r.input_kept   ? " (no try less tangled: kept the input unchanged)"

@@ -216,6 +216,7 @@ std::optional<Scene> prepare_input(const Scene& input, const std::string& name, 
         u.retry_passes_factor = last ? defaults.retry_passes_factor : 1.0;
         u.loop_readings = last && defaults.loop_readings;
         u.untwist = last && defaults.untwist;
+        u.retract_ends = last && defaults.retract_ends;
         u.restart = last && defaults.restart;
         scene = untangle_input(starts[i], u, info, after, progress);
         if (after.is_collision_free()) break;

@@ -72,6 +72,15 @@ void measure_displacement(const Scene& result, const Scene& from, UntangleReport
         }
 }
 
+CheckParams judge_params(const UntangleParams& params, const std::vector<int>& outside_signs) {
+    CheckParams check;
+    check.separation_tolerance = params.separation_tolerance;
+    check.outside_sides = outside_signs;
+    const bool has_sides = params.input_sides && !params.input_sides->empty();
+    check.input_sides = has_sides ? params.input_sides : nullptr;
+    return check;
+}
+
 UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
                               const UntangleParams& params, const ProgressFn& progress,
                               bool keep_simple, const Box2* region, bool ends_by_nearest) {
@@ -89,15 +98,12 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
         // judge by, with the sides given if any (a fresh vote on the result could flip a short
         // layer's outside and call a swapped order clean).
         detail::EngineSettings settings = detail::resolve_settings(scene, params);
-        CheckParams check_params;
-        check_params.separation_tolerance = params.separation_tolerance;
-        check_params.outside_sides = settings.outside_signs;
+        CheckParams check_params = judge_params(params, settings.outside_signs);
         // Short passes (UntangleParams' defaults): shape matching pulls toward the input.
         settings.rest_at_start = true;
         settings.keep_simple = keep_simple;
         settings.ends_by_nearest = ends_by_nearest;
-        const bool has_sides = params.input_sides && !params.input_sides->empty();
-        check_params.input_sides = has_sides ? params.input_sides : nullptr;
+        const bool has_sides = check_params.input_sides != nullptr;
         settings.open_cut_bends = has_sides && params.open_cut_bends;
         // `check`: the last whole check, if any; `counts`: the last check's counts. The check
         // of the input (the reference of the region checks) runs beside the engine's first

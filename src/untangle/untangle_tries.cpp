@@ -5,6 +5,8 @@
 
 #include "strata/geometry/checks.h"
 #include "strata/geometry/input_sides.h"
+#include "untangle/detail/engine.h"
+#include "untangle/detail/retract_ends.h"
 #include "untangle/detail/run.h"
 #include "untangle/detail/try_list.h"
 #include "untangle/detail/untwist.h"
@@ -489,6 +491,23 @@ UntangleReport untwisted_try(Scene& scene, const Scene& input, const UntanglePar
     return report;
 }
 
+// The least tangled result `scene` (`failed`, from `input`), after untwisted_try() if it ran:
+// retract_ends() judged by the sides that result was tried with (`p`), then one more try from
+// there by them (no self-crossing made); kept when clean (report.ends_retracted).
+UntangleReport retracted_ends_try(Scene& scene, const Scene& input, const UntangleParams& p,
+                                  const UntangleReport& failed, const ProgressFn& progress) {
+    std::size_t retracted = 0;
+    UntangleReport report =
+        from_least_tangled(scene, input, failed, [&](Scene& s) -> std::optional<UntangleReport> {
+            const detail::EngineSettings settings = detail::resolve_settings(s, p);
+            retracted = detail::retract_ends(s, detail::judge_params(p, settings.outside_signs));
+            if (retracted == 0) return std::nullopt;
+            return detail::run_untangling(s, whole_scene_pieces(s), p, progress, true);
+        });
+    report.ends_retracted = report.collision_free ? retracted : 0;
+    return report;
+}
+
 UntangleReport given_sides_tries(Scene& scene, const UntangleParams& params,
                                  const ProgressFn& progress, LeastTangled& failures);
 
@@ -809,6 +828,8 @@ UntangleReport inferring_sides_call(Scene& scene, const UntangleParams& params,
         UntangleReport last = report;
         if (report.self_crossings_after > 0 && params.untwist)
             last = untwisted_try(scene, input, p, report, progress);
+        if (!last.collision_free && params.retract_ends)
+            last = retracted_ends_try(scene, input, p, last, progress);
         if (!report.input_kept && !last.collision_free && params.restart)
             last = restarted_tries(scene, input, p, last, progress);
         return with_short_edges(scene, input, params, progress, last);

@@ -368,7 +368,7 @@ TEST_CASE("untangle_inferring_sides: the short edges passed when everything else
     params.retry_passes_factor = 1.0;
     params.more_passes_factor = 1;
     params.retry_ends_by_nearest = params.loop_readings = false;
-    params.untwist = params.restart = false;
+    params.untwist = params.retract_ends = params.restart = false;
     UntangleParams without = params;
     without.retry_short_edge_fraction = 0.0;
     Scene failed = input;

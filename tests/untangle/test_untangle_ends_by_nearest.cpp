@@ -58,7 +58,8 @@ TEST_CASE("untangle_inferring_sides: a last retry with the ends read by the near
     params.retry_passes_factor = 1.0;
     params.more_passes_factor = 1;
     params.other_readings = 0;
-    params.loop_readings = params.untwist = params.restart = false;  // nor the last resorts
+    params.loop_readings = params.untwist = params.retract_ends = params.restart =
+        false;                                                       // nor the last resorts
     params.retry_short_edge_fraction = 0.0;                          // nor the retry after them
     UntangleParams without = params;
     without.retry_ends_by_nearest = false;

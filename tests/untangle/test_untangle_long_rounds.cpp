@@ -45,7 +45,7 @@ TEST_CASE("untangle_inferring_sides: longer rounds when every try fails (folded 
         without.long_rounds_factor = 1;
         without.more_passes_factor = 1;  // the tries alone, no retry
         without.retry_passes_factor = 1.0;
-        without.untwist = without.restart = false;  // nor the last resorts
+        without.untwist = without.retract_ends = without.restart = false;  // nor the last resorts
         without.retry_short_edge_fraction = 0.0;    // nor the retry after them
         without.retry_ends_by_nearest = false;  // which cleans it too
         Scene failed = tangled;

@@ -25,7 +25,8 @@ TEST_CASE("untangle_inferring_sides: every try once more with more passes when a
     params.long_rounds_factor = 1;  // the retry alone
     params.more_passes_factor = 1;
     params.other_readings = 0;
-    params.loop_readings = params.untwist = params.restart = false;  // the retry alone
+    params.loop_readings = params.untwist = params.retract_ends = params.restart =
+        false;  // the retry alone
     params.retry_short_edge_fraction = 0.0;
     UntangleParams without = params;
     without.retry_passes_factor = 1.0;

@@ -104,6 +104,15 @@ struct UntangleParams {
     /// try from there by the same sides, with no self-crossing made; kept when clean
     /// (report.untwisted).
     bool untwist = true;
+    /// untangle_inferring_sides(), when every try has failed (the untwisting too, if it ran):
+    /// the ends of open layers of the least tangled result (the input, when no try was less
+    /// tangled) whose end segment meets another segment or whose end vertex is on the wrong
+    /// side of a layer or too close to it, moved back along their own end segment where the
+    /// check (by the sides that result was tried with) counts fewer crossings, self-crossings,
+    /// nesting violations or separation violations (in that order), then one more try from
+    /// there by the same sides, with no self-crossing made; kept when clean
+    /// (report.ends_retracted). An end moves by at most 3/4 of its end segment.
+    bool retract_ends = true;
     /// untangle_inferring_sides(), when every try has failed (the untwisting too, if it ran)
     /// and the least tangled result is not the input: untangle()'s two tries, long rounds and
     /// the retry with more passes once more from that result, by the sides it was tried with;
@@ -271,6 +280,10 @@ struct UntangleReport {
     /// self-crossings; the result is that one with them taken out one vertex move at a time,
     /// then one more try from there (params.untwist).
     bool untwisted = false;
+    /// untangle_inferring_sides(): every try failed (untwisted too, if tried); the result is
+    /// the least tangled one with this many ends of open layers moved back along their end
+    /// segments, then one more try from there (params.retract_ends). 0 otherwise.
+    std::size_t ends_retracted = 0;
     /// untangle_inferring_sides(): every try failed (untwisted too, if tried), and the result
     /// is that of untangle()'s tries, long rounds and more passes once more from the least
     /// tangled result, by the sides it was tried with (params.restart).
@@ -341,7 +354,9 @@ UntangleReport untangle(Scene& scene, const UntangleParams& params = {},
 /// that fails: params' own sides' first and second tries with the ends read by the nearest
 /// feature (params.retry_ends_by_nearest, report.ends_by_nearest); without an original, the
 /// loop readings (params.loop_readings); then, with or without, the least tangled result's
-/// self-crossings untwisted and one more try from there (params.untwist), then untangle()'s
+/// self-crossings untwisted and one more try from there (params.untwist), then its ends that
+/// poke through or lie on the wrong side retracted and one more try (params.retract_ends),
+/// then untangle()'s
 /// tries once more from that result (params.restart), each kept when clean; then, from the
 /// input, params' own sides' first and second tries with the short edges passed
 /// (params.retry_short_edge_fraction, report.short_edges). When every try

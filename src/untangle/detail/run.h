@@ -3,6 +3,7 @@
 // untangle_local(). Internal to the untangle module.
 
 #include "strata/core/progress.h"
+#include "strata/geometry/checks.h"
 #include "strata/untangle/localize.h"
 #include "strata/untangle/untangle.h"
 
@@ -20,6 +21,11 @@ UntangleReport run_untangling(Scene& scene, const std::vector<Piece>& pieces,
                               const UntangleParams& params, const ProgressFn& progress,
                               bool keep_simple = false, const Box2* region = nullptr,
                               bool ends_by_nearest = false);
+
+// The check that judges run_untangling()'s results with `params`: the outside sides
+// `outside_signs` (EngineSettings::outside_signs of the scene untangled), params' separation
+// tolerance and input sides, if any.
+CheckParams judge_params(const UntangleParams& params, const std::vector<int>& outside_signs);
 
 // report.max_displacement and moved_vertices of `result` against `from` (the same layers and
 // vertex counts): the largest vertex move, and the vertices moved by more than 1e-12 x the
