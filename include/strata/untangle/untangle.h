@@ -111,7 +111,7 @@ struct UntangleParams {
     /// check (by the sides that result was tried with) counts fewer crossings, self-crossings,
     /// nesting violations or separation violations (in that order), then one more try from
     /// there by the same sides, with no self-crossing made; kept when clean
-    /// (report.ends_retracted). An end moves by at most 3/4 of its end segment.
+    /// (report.ends_retracted). An end moves by less than its end segment's length.
     bool retract_ends = true;
     /// untangle_inferring_sides(), when every try has failed (the untwisting too, if it ran)
     /// and the least tangled result is not the input: untangle()'s two tries, long rounds and
